@@ -1,0 +1,82 @@
+// Analytic scenes shared by all three methods (mobile, sampled, reference). A scene is a camera
+// and a few spheres; every pixel is ray-traced against them (exact normals, no mesh), so the GPU
+// and the CPU see the same geometry. Pixels that hit no sphere are black (0): the environment
+// is seen only through reflections, so metrics measure lighting, not the backdrop.
+//
+// Camera convention (the GLSL in renderers/shaders/scene.glsl mirrors it): pixel (x, y), y down,
+// sample position (x + sx, y + sy) with sx, sy in [0,1); ndc = (2·px/W − 1, 1 − 2·py/H).
+//   orthographic: origin = eye + right·ndc.x·half_w + up·ndc.y·half_h, dir = forward
+//   perspective:  origin = eye, dir = normalize(forward + right·ndc.x·tan(fov/2)·W/H + up·ndc.y·tan(fov/2))
+// where half_w = half_h·W/H, forward = normalize(target − eye), right = normalize(forward × world_up),
+// up = right × forward. World is Y-up, right-handed.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "harness/common/options.h"
+
+namespace iblcheck {
+
+struct Material {
+    Vec3f base_color{1, 1, 1};
+    float metallic = 0;
+    float roughness = 0.5f; // perceptual; α = r²
+};
+
+struct Sphere {
+    Vec3f center;
+    float radius = 1;
+    Material material;
+    // Animated-normal detail (temporal scenes); 0 amplitude = smooth sphere.
+    float bump_amplitude = 0;
+    float bump_frequency = 0;
+    float bump_phase = 0;
+};
+
+struct Camera {
+    bool orthographic = true;
+    Vec3f eye{0, 0, 5};
+    Vec3f target{0, 0, 0};
+    Vec3f world_up{0, 1, 0};
+    float half_height = 1.1f;   // orthographic
+    float fov_y_deg = 40.0f;    // perspective
+};
+
+struct Scene {
+    std::string name;
+    Camera camera;
+    std::vector<Sphere> spheres;
+    int width = 128;  // default image size; --size overrides
+    int height = 128;
+    // Labels of the spheres in order (e.g. "metal r=0.3"), used by per-roughness metrics.
+    std::vector<std::string> labels;
+};
+
+struct SceneInfo {
+    std::string name;
+    std::string description;
+};
+
+// The built-in scenes (`iblcheck list`).
+std::vector<SceneInfo> scene_catalog();
+
+// Material options every scene understands: roughness, metallic, base_color.
+// Throws UsageError naming the scene and listing the valid ones.
+Scene build_scene(const std::string& name, const OptionMap& options);
+
+// The option keys build_scene reads (so callers can reject unknown keys).
+const std::vector<std::string>& scene_option_keys();
+
+// Ray–scene intersection used by the CPU methods: nearest hit along (o, d), d unit.
+struct Hit {
+    bool hit = false;
+    int sphere = -1;
+    float t = 0;
+    Vec3f position, normal;
+};
+Hit intersect(const Scene& scene, Vec3f origin, Vec3f dir);
+
+// Camera ray through (px, py) in pixel units (x + sx, y + sy); see the convention above.
+void camera_ray(const Scene& scene, int width, int height, double px, double py, Vec3f& origin, Vec3f& dir);
+
+} // namespace iblcheck
