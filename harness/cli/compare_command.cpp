@@ -1,0 +1,182 @@
+#include "harness/cli/compare_command.h"
+
+#include <algorithm>
+#include <cmath>
+#include <iostream>
+#include <memory>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "harness/common/errors.h"
+#include "metrics/flip.h"
+#include "metrics/image_io.h"
+#include "metrics/psnr.h"
+#include "metrics/ssim.h"
+
+namespace iblcheck {
+
+namespace {
+
+std::string lower_ext(const std::string& path) {
+    const auto dot = path.find_last_of('.');
+    if (dot == std::string::npos) return "";
+    std::string e = path.substr(dot + 1);
+    std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    return e;
+}
+
+// JSON cannot hold inf (identical images give PSNR = +inf): write null.
+nlohmann::json num(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+
+} // namespace
+
+int run_compare(const CompareArgs& a, std::ostream& out, std::ostream& err) {
+    try {
+        const bool want_flip = a.metric == "flip" || a.metric == "all";
+        const bool want_ssim = a.metric == "ssim" || a.metric == "all";
+        const bool want_psnr = a.metric == "psnr" || a.metric == "all";
+        if (!want_flip && !want_ssim && !want_psnr)
+            throw UsageError("--metric: '" + a.metric + "' is not one of flip, ssim, psnr, all");
+        if (a.mode != "auto" && a.mode != "ldr" && a.mode != "hdr")
+            throw UsageError("--mode: '" + a.mode + "' is not one of auto, ldr, hdr");
+        const flip::ToneMapper tm = flip::parse_tone_mapper(a.tone_mapper);
+
+        LoadedImage ref = read_image(a.reference);
+        LoadedImage test = read_image(a.test);
+        check_same_size(ref.pixels, test.pixels, a.reference, a.test);
+        // Grey vs colour, or colour vs colour+alpha, is a different kind of image: refuse.
+        const int ch_ref = ref.file_channels <= 2 ? 1 : 3, ch_test = test.file_channels <= 2 ? 1 : 3;
+        if (ch_ref != ch_test)
+            throw InputError(fmt::format("{}: has {} channel(s) but {} has {}", a.test,
+                                         test.file_channels, a.reference, ref.file_channels));
+        if (ref.hdr != test.hdr)
+            throw InputError(fmt::format("{}: is {} but {} is {}", a.test, test.hdr ? "HDR" : "LDR",
+                                         a.reference, ref.hdr ? "HDR" : "LDR"));
+        // The FLIP tool scores +Inf pixels as 0 error; a NaN/Inf is a renderer bug, not a score.
+        check_finite(ref.pixels, a.reference);
+        check_finite(test.pixels, a.test);
+
+        bool hdr = a.mode == "hdr" || (a.mode == "auto" && (ref.hdr || lower_ext(a.reference) == "exr" ||
+                                                             lower_ext(a.reference) == "hdr"));
+        size_t clamped[2] = {0, 0};
+        if (hdr) {
+            LoadedImage* imgs[2] = {&ref, &test};
+            for (int i = 0; i < 2; ++i) {
+                const size_t neg = count_negative(imgs[i]->pixels);
+                if (neg == 0) continue;
+                if (!a.clamp_negative)
+                    throw InputError(fmt::format(
+                        "{}: {} negative value(s) in HDR input (radiance must be >= 0; "
+                        "use --clamp-negative to clamp them to 0)", imgs[i]->path, neg));
+                clamped[i] = clamp_negative(imgs[i]->pixels);
+            }
+        }
+
+        nlohmann::json j = nlohmann::json::object();
+        FlipResult fr;
+        if (want_flip) {
+            FlipOptions fo;
+            if (a.ppd > 0) fo.ppd = a.ppd;
+            fo.tone_mapper = tm;
+            fo.start_exposure = a.start_exposure;
+            fo.stop_exposure = a.stop_exposure;
+            fo.threads = a.threads;
+            fr = hdr ? compute_flip_hdr(ref.pixels, test.pixels, fo)
+                     : compute_flip_ldr(ref.pixels, test.pixels, fo);
+            nlohmann::json f = {{"mean", fr.mean},
+                                {"weighted_median", fr.weighted_median},
+                                {"weighted_q1", fr.weighted_q1},
+                                {"weighted_q3", fr.weighted_q3},
+                                {"p99", fr.p99},
+                                {"min", fr.min},
+                                {"max", fr.max},
+                                {"block_max", fr.block_max},
+                                {"block_x", fr.block_x},
+                                {"block_y", fr.block_y},
+                                {"mode", fr.mode},
+                                {"ppd", fr.ppd}};
+            if (hdr) {
+                f["start_exposure"] = fr.start_exposure;
+                f["stop_exposure"] = fr.stop_exposure;
+                f["num_exposures"] = fr.num_exposures;
+                f["tone_mapper"] = flip::tone_mapper_name(tm);
+            }
+            j["flip"] = f;
+            if (!a.heatmap.empty()) write_png(a.heatmap, magma_heatmap(fr.errmap));
+            if (!a.errmap.empty()) write_exr(a.errmap, fr.errmap);
+        }
+        if (want_ssim) {
+            const SsimResult s = hdr ? compute_ssim_hdr(ref.pixels, test.pixels)
+                                     : compute_ssim(ref.pixels, test.pixels);
+            j["ssim"] = {{"mean", s.mean}};
+        }
+        if (want_psnr) {
+            const PsnrResult p = compute_psnr(ref.pixels, test.pixels);
+            j["psnr"] = {{"db", num(p.db)}, {"rmse", p.rmse}, {"max_abs", p.max_abs}};
+            if (hdr) j["psnr"]["relative_mse"] = compute_relative_mse(ref.pixels, test.pixels);
+        }
+        if (clamped[0] || clamped[1])
+            j["clamped_negative"] = {{"reference", clamped[0]}, {"test", clamped[1]}};
+
+        if (a.json) {
+            out << j.dump(2) << "\n";
+        } else {
+            out << fmt::format("reference: {}\ntest:      {}\nmode:      {}\n", a.reference, a.test,
+                               hdr ? "hdr" : "ldr");
+            if (clamped[0] || clamped[1])
+                out << fmt::format("clamped negative values: reference {}, test {}\n", clamped[0], clamped[1]);
+            if (want_flip) {
+                out << fmt::format("FLIP mean {:.6f}  weighted median {:.6f}  (q1 {:.6f}, q3 {:.6f})  "
+                                   "p99 {:.6f}  max {:.6f}\n",
+                                   fr.mean, fr.weighted_median, fr.weighted_q1, fr.weighted_q3, fr.p99, fr.max);
+                out << fmt::format("FLIP worst 16x16 block: mean {:.6f} at x={}, y={}\n", fr.block_max,
+                                   fr.block_x, fr.block_y);
+                if (hdr)
+                    out << fmt::format("HDR-FLIP exposures: {:.4f} to {:.4f}, {} exposures ({})\n",
+                                       fr.start_exposure, fr.stop_exposure, fr.num_exposures,
+                                       flip::tone_mapper_name(tm));
+            }
+            if (want_ssim) out << fmt::format("SSIM {:.6f}\n", j["ssim"]["mean"].get<double>());
+            if (want_psnr) {
+                const auto& p = j["psnr"];
+                out << fmt::format("PSNR {} dB  RMSE {:.6f}  max |diff| {:.6f}\n",
+                                   p["db"].is_null() ? std::string("inf") : fmt::format("{:.4f}", p["db"].get<double>()),
+                                   p["rmse"].get<double>(), p["max_abs"].get<double>());
+            }
+        }
+        return kExitPass;
+    } catch (const Error& e) {
+        err << "error: " << e.what() << "\n";
+        return kExitError;
+    } catch (const cv::Exception& e) {
+        err << "error: " << e.what() << "\n";
+        return kExitError;
+    }
+}
+
+void register_compare_command(CLI::App& app, int& exit_code) {
+    auto args = std::make_shared<CompareArgs>();
+    auto* sub = app.add_subcommand("compare", "Compare two images with FLIP, SSIM and PSNR");
+    sub->add_option("REF", args->reference, "Reference image (EXR/HDR linear, PNG/JPG sRGB)")->required();
+    sub->add_option("TEST", args->test, "Test image")->required();
+    sub->add_option("--metric", args->metric, "flip|ssim|psnr|all")
+        ->check(CLI::IsMember({"flip", "ssim", "psnr", "all"}));
+    sub->add_option("--mode", args->mode, "auto|ldr|hdr (auto: EXR/HDR -> hdr)")
+        ->check(CLI::IsMember({"auto", "ldr", "hdr"}));
+    sub->add_option("--heatmap", args->heatmap, "Write the FLIP error map as a magma PNG");
+    sub->add_option("--errmap", args->errmap, "Write the FLIP error map as a float EXR");
+    sub->add_flag("--json", args->json, "Print one JSON object");
+    sub->add_option("--ppd", args->ppd, "Pixels per degree (default 67.0206451)")->check(CLI::PositiveNumber);
+    sub->add_option("--tone-mapper", args->tone_mapper, "HDR-FLIP tone mapper: aces|hable|reinhard")
+        ->check(CLI::IsMember({"aces", "hable", "reinhard"}));
+    sub->add_option("--start-exposure", args->start_exposure, "HDR-FLIP start exposure (stops)");
+    sub->add_option("--stop-exposure", args->stop_exposure, "HDR-FLIP stop exposure (stops)");
+    sub->add_flag("--clamp-negative", args->clamp_negative,
+                  "Clamp negative HDR values to 0 (and report how many) instead of failing");
+    sub->add_option("--threads", args->threads, "Worker threads (0: all cores)");
+    sub->callback([args, &exit_code] { exit_code = run_compare(*args, std::cout, std::cerr); });
+}
+
+} // namespace iblcheck

@@ -1,0 +1,38 @@
+// Image files at the edges of the harness (OpenImageIO). In memory every image is a cv::Mat,
+// CV_32FC3 in RGB order (not OpenCV's BGR): linear radiance for HDR files (EXR, Radiance HDR,
+// float TIFF), sRGB-encoded values in [0,1] for 8/16-bit files (PNG, JPEG...).
+// Bad input throws iblcheck::InputError whose message starts with the file path.
+#pragma once
+#include <string>
+
+#include <opencv2/core.hpp>
+
+namespace iblcheck {
+
+struct LoadedImage {
+    cv::Mat pixels;         // CV_32FC3, RGB
+    bool hdr = false;       // true: linear float data (EXR/HDR/float TIFF); false: sRGB in [0,1]
+    int file_channels = 0;  // channels in the file before dropping alpha / expanding grey
+    std::string path;
+};
+
+// Reads an image; grey becomes 3 equal channels, alpha (4th channel, or 2nd of grey+alpha) is
+// dropped. Throws InputError: missing file, unreadable/corrupt data, unsupported channel count.
+LoadedImage read_image(const std::string& path);
+
+// Writes float data as EXR (half is not used: float keeps error maps exact). 1 or 3 channels.
+void write_exr(const std::string& path, const cv::Mat& mat);
+// Writes 8-bit PNG from float values in [0,1] (clamped, rounded), 1 or 3 channels, RGB order.
+void write_png(const std::string& path, const cv::Mat& mat);
+
+// NaN/Inf check: throws InputError "<path>: N non-finite value(s) (NaN/Inf), first at x=X, y=Y".
+void check_finite(const cv::Mat& mat, const std::string& path);
+// Number of negative channel values (HDR radiance must be >= 0).
+size_t count_negative(const cv::Mat& mat);
+// Clamps negative values to 0 in place; returns how many were changed.
+size_t clamp_negative(cv::Mat& mat);
+// Throws InputError naming both files when the sizes differ.
+void check_same_size(const cv::Mat& a, const cv::Mat& b, const std::string& path_a,
+                     const std::string& path_b);
+
+} // namespace iblcheck

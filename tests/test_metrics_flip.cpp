@@ -1,0 +1,372 @@
+// FLIP agreement with NVIDIA's reference tool (NVlabs/flip v1.6) on the shared test vectors
+// (IBLCHECK_SHARED_DIR/flip-vectors, described by its expected.json), plus the heatmap,
+// threading determinism and `iblcheck compare` behaviour on good and bad input.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "harness/cli/compare_command.h"
+#include "harness/common/errors.h"
+#include "metrics/display_transform.h"
+#include "metrics/flip.h"
+#include "metrics/flip/magma_table.h"
+#include "metrics/image_io.h"
+
+namespace fs = std::filesystem;
+using namespace iblcheck;
+
+namespace {
+
+const fs::path kVectors = fs::path(IBLCHECK_SHARED_DIR) / "flip-vectors";
+
+#define REQUIRE_VECTORS()                                                                        \
+    if (!fs::exists(kVectors / "expected.json"))                                                 \
+    GTEST_SKIP() << kVectors.string() << " not found: the FLIP test vectors (expected.json, "    \
+                 << "image pairs, reference error maps) live in the shared folder beside the checkout"
+
+nlohmann::json expected() {
+    std::ifstream f(kVectors / "expected.json");
+    return nlohmann::json::parse(f);
+}
+
+nlohmann::json pair_named(const std::string& name) {
+    static const nlohmann::json all = expected();
+    for (const auto& p : all["pairs"])
+        if (p["name"] == name) return p;
+    throw std::runtime_error("no pair " + name);
+}
+
+// Cache: the 1080p pairs are used by several tests.
+const FlipResult& flip_for(const std::string& name) {
+    static std::map<std::string, FlipResult> cache;
+    auto it = cache.find(name);
+    if (it != cache.end()) return it->second;
+    const auto p = pair_named(name);
+    const auto ref = read_image((kVectors / p["reference"].get<std::string>()).string());
+    const auto test = read_image((kVectors / p["test"].get<std::string>()).string());
+    FlipResult r = p["mode"] == "hdr" ? compute_flip_hdr(ref.pixels, test.pixels)
+                                      : compute_flip_ldr(ref.pixels, test.pixels);
+    return cache.emplace(name, std::move(r)).first->second;
+}
+
+class FlipVectors : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(FlipVectors, AgreesWithReferenceTool) {
+    REQUIRE_VECTORS();
+    const auto p = pair_named(GetParam());
+    const FlipResult& r = flip_for(GetParam());
+    ASSERT_EQ(r.errmap.cols, p["width"].get<int>());
+    ASSERT_EQ(r.errmap.rows, p["height"].get<int>());
+    EXPECT_EQ(r.mode, p["mode"].get<std::string>());
+
+    // Per-pixel agreement with the tool's error map.
+    const auto ref_map = read_image((kVectors / p["errmap"].get<std::string>()).string());
+    double max_delta = 0.0;
+    int mx = 0, my = 0;
+    for (int y = 0; y < r.errmap.rows; ++y) {
+        const float* a = r.errmap.ptr<float>(y);
+        const float* b = ref_map.pixels.ptr<float>(y);
+        for (int x = 0; x < r.errmap.cols; ++x) {
+            const double d = std::fabs(double(a[x]) - double(b[3 * x]));
+            if (d > max_delta) max_delta = d, mx = x, my = y;
+        }
+    }
+    std::cout << "[ " << GetParam() << " ] max per-pixel |delta| = " << max_delta << " at (" << mx
+              << ", " << my << "); mean " << r.mean << " vs " << p["mean_double"].get<double>()
+              << " (delta " << r.mean - p["mean_double"].get<double>() << ")\n";
+    EXPECT_LE(max_delta, 2e-4) << "at x=" << mx << ", y=" << my;
+
+    EXPECT_NEAR(r.mean, p["mean_double"].get<double>(), 1e-5);
+    EXPECT_NEAR(r.weighted_median, p["weighted_median"].get<double>(), 1e-4);
+    EXPECT_NEAR(r.weighted_q1, p["weighted_q1"].get<double>(), 1e-4);
+    EXPECT_NEAR(r.weighted_q3, p["weighted_q3"].get<double>(), 1e-4);
+    EXPECT_NEAR(r.min, p["min"].get<double>(), 1e-4);
+    EXPECT_NEAR(r.max, p["max"].get<double>(), 2e-4);
+    EXPECT_NEAR(r.ppd, 67.0206451, 1e-5);
+    if (p["mode"] == "hdr") {
+        EXPECT_NEAR(r.start_exposure, p["start_exposure"].get<double>(), 1e-4);
+        EXPECT_NEAR(r.stop_exposure, p["stop_exposure"].get<double>(), 1e-4);
+        EXPECT_EQ(r.num_exposures, p["num_exposures"].get<int>());
+    }
+    // Sanity of the extra statistics.
+    EXPECT_GE(r.p99, r.weighted_median * 0.5);
+    EXPECT_LE(r.p99, r.max);
+    EXPECT_GE(r.block_max, r.mean);
+    EXPECT_LE(r.block_max, r.max);
+}
+
+INSTANTIATE_TEST_SUITE_P(AllPairs, FlipVectors,
+                         ::testing::Values("gen512_ldr", "gen512_hdr", "ref1080_ldr", "ramp1080_hdr"));
+
+// Random image of a given size, sRGB values in [0,1] with smooth structure plus noise.
+cv::Mat synthetic(int w, int h, unsigned seed, float noise) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> u(-noise, noise);
+    cv::Mat m(h, w, CV_32FC3);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            auto* p = m.ptr<float>(y) + 3 * x;
+            p[0] = std::clamp(0.5f + 0.4f * std::sin(x * 0.1f) + u(rng), 0.0f, 1.0f);
+            p[1] = std::clamp(0.5f + 0.4f * std::cos(y * 0.07f) + u(rng), 0.0f, 1.0f);
+            p[2] = std::clamp(float(x + y) / float(w + h) + u(rng), 0.0f, 1.0f);
+        }
+    return m;
+}
+
+TEST(Flip, IdenticalImagesGiveZeroError) {
+    const cv::Mat a = synthetic(64, 48, 1, 0.05f);
+    const FlipResult r = compute_flip_ldr(a, a);
+    EXPECT_EQ(r.max, 0.0);
+    EXPECT_EQ(r.mean, 0.0);
+    const FlipResult h = compute_flip_hdr(a * 4.0, a * 4.0);
+    EXPECT_EQ(h.max, 0.0);
+}
+
+TEST(Flip, ErrorGrowsWithDistortion) {
+    const cv::Mat a = synthetic(96, 64, 2, 0.0f);
+    const cv::Mat b1 = a + cv::Scalar(0.02, 0.02, 0.02), b2 = a + cv::Scalar(0.2, 0.0, 0.0);
+    const double e1 = compute_flip_ldr(a, b1).mean, e2 = compute_flip_ldr(a, b2).mean;
+    EXPECT_GT(e1, 0.0);
+    EXPECT_GT(e2, e1 * 2);
+}
+
+TEST(Flip, ThreadCountDoesNotChangeResults) {
+    const cv::Mat a = synthetic(173, 97, 3, 0.1f), b = synthetic(173, 97, 4, 0.1f);
+    FlipOptions o1, o2, o3;
+    o1.threads = 1, o2.threads = 2, o3.threads = 5;
+    const FlipResult r1 = compute_flip_hdr(a * 3.0, b * 3.0, o1);
+    const FlipResult r2 = compute_flip_hdr(a * 3.0, b * 3.0, o2);
+    const FlipResult r3 = compute_flip_hdr(a * 3.0, b * 3.0, o3);
+    EXPECT_EQ(cv::norm(r1.errmap, r2.errmap, cv::NORM_INF), 0.0);
+    EXPECT_EQ(cv::norm(r1.errmap, r3.errmap, cv::NORM_INF), 0.0);
+    EXPECT_EQ(r1.mean, r2.mean);
+    EXPECT_EQ(r1.weighted_median, r3.weighted_median);
+    const FlipResult l1 = compute_flip_ldr(a, b, o1), l2 = compute_flip_ldr(a, b, o2);
+    EXPECT_EQ(cv::norm(l1.errmap, l2.errmap, cv::NORM_INF), 0.0);
+}
+
+TEST(Flip, ThreadCountBitIdenticalOn1080p) {
+    REQUIRE_VECTORS();
+    const auto ref = read_image((kVectors / "reference.png").string());
+    const auto test = read_image((kVectors / "reference_degraded.png").string());
+    FlipOptions o1, o2;
+    o1.threads = 1, o2.threads = 2;
+    const FlipResult r1 = compute_flip_ldr(ref.pixels, test.pixels, o1);
+    const FlipResult r2 = compute_flip_ldr(ref.pixels, test.pixels, o2);
+    EXPECT_EQ(cv::norm(r1.errmap, r2.errmap, cv::NORM_INF), 0.0);
+    EXPECT_EQ(r1.mean, r2.mean);
+}
+
+TEST(Flip, ExplicitExposuresAreUsed) {
+    const cv::Mat a = synthetic(64, 64, 5, 0.05f) * 2.0, b = synthetic(64, 64, 6, 0.05f) * 2.0;
+    FlipOptions o;
+    o.start_exposure = -1.0f;
+    o.stop_exposure = 2.0f;
+    const FlipResult r = compute_flip_hdr(a, b, o);
+    EXPECT_EQ(r.start_exposure, -1.0);
+    EXPECT_EQ(r.stop_exposure, 2.0);
+    EXPECT_EQ(r.num_exposures, 3);
+    o.stop_exposure = -2.0f;
+    EXPECT_THROW(compute_flip_hdr(a, b, o), UsageError);
+}
+
+TEST(Flip, SizeMismatchThrows) {
+    EXPECT_THROW(compute_flip_ldr(synthetic(32, 32, 1, 0), synthetic(33, 32, 1, 0)), InputError);
+}
+
+TEST(Flip, BlockMaxFindsTheWorstBlock) {
+    FlipResult r;
+    r.errmap = cv::Mat::zeros(40, 50, CV_32F);
+    r.errmap(cv::Rect(32, 16, 16, 16)).setTo(0.5f);
+    r.errmap.at<float>(0, 0) = 1.0f; // a single hot pixel does not beat a whole bad block
+    pool_flip_errmap(r);
+    EXPECT_EQ(r.block_x, 32);
+    EXPECT_EQ(r.block_y, 16);
+    EXPECT_DOUBLE_EQ(r.block_max, 0.5);
+    EXPECT_EQ(r.max, 1.0);
+    EXPECT_NEAR(r.mean, (256 * 0.5 + 1.0) / 2000.0, 1e-12);
+}
+
+TEST(Flip, MagmaHeatmapMatchesTable) {
+    cv::Mat e(1, 4, CV_32F);
+    e.at<float>(0, 0) = 0.0f;
+    e.at<float>(0, 1) = 1.0f;
+    e.at<float>(0, 2) = 0.5f;        // 128.0 -> entry 128
+    e.at<float>(0, 3) = 10.0f / 255; // entry 10
+    const cv::Mat h = magma_heatmap(e);
+    ASSERT_EQ(h.type(), CV_32FC3);
+    const float* p = h.ptr<float>(0);
+    EXPECT_FLOAT_EQ(p[0], 0.001462f);
+    EXPECT_FLOAT_EQ(p[2], 0.013866f);
+    EXPECT_FLOAT_EQ(p[3], 0.987053f);
+    EXPECT_FLOAT_EQ(p[5], 0.749504f);
+    EXPECT_FLOAT_EQ(p[6], flip::kMagma[128][0]);
+    EXPECT_FLOAT_EQ(p[9 + 1], flip::kMagma[10][1]);
+}
+
+TEST(DisplayTransform, AcesThenSrgb) {
+    EXPECT_FLOAT_EQ(display_transform_channel(0.0f), 0.0f);
+    // ACES fitted at x = 0.6 * 1: (0.36*2.51 + 0.018) / (0.36*2.43 + 0.354 + 0.14) = 0.68685...
+    const float aces1 = (0.36f * 2.51f + 0.018f) / (0.36f * 2.43f + 0.354f + 0.14f);
+    EXPECT_NEAR(display_transform_channel(1.0f), 1.055f * std::pow(aces1, 1.0f / 2.4f) - 0.055f, 1e-6);
+    EXPECT_NEAR(display_transform_channel(1e6f), 1.0f, 1e-6); // saturates (2.51/2.43 clamped)
+}
+
+// ---------------------------------------------------------------------------------------------
+// `iblcheck compare`
+
+class CompareCommand : public ::testing::Test {
+  protected:
+    void SetUp() override {
+        dir_ = fs::temp_directory_path() /
+               ("iblcheck_compare_" + std::to_string(::getpid()) + "_" +
+                ::testing::UnitTest::GetInstance()->current_test_info()->name());
+        fs::create_directories(dir_);
+    }
+    void TearDown() override { fs::remove_all(dir_); }
+    std::string path(const std::string& name) const { return (dir_ / name).string(); }
+
+    int run(CompareArgs a) {
+        out_.str(""), err_.str("");
+        return run_compare(a, out_, err_);
+    }
+    CompareArgs args(const std::string& r, const std::string& t) {
+        CompareArgs a;
+        a.reference = r, a.test = t;
+        return a;
+    }
+    fs::path dir_;
+    std::ostringstream out_, err_;
+};
+
+TEST_F(CompareCommand, LdrPairJson) {
+    const cv::Mat a = synthetic(64, 48, 7, 0.02f), b = synthetic(64, 48, 8, 0.05f);
+    write_png(path("a.png"), a);
+    write_png(path("b.png"), b);
+    CompareArgs c = args(path("a.png"), path("b.png"));
+    c.json = true;
+    c.heatmap = path("heat.png");
+    c.errmap = path("err.exr");
+    ASSERT_EQ(run(c), 0) << err_.str();
+    const auto j = nlohmann::json::parse(out_.str());
+    EXPECT_EQ(j["flip"]["mode"], "ldr");
+    EXPECT_GT(j["flip"]["mean"].get<double>(), 0.0);
+    EXPECT_LT(j["ssim"]["mean"].get<double>(), 1.0);
+    EXPECT_GT(j["psnr"]["db"].get<double>(), 10.0);
+    EXPECT_FALSE(j["flip"].contains("start_exposure"));
+    EXPECT_TRUE(fs::exists(path("heat.png")));
+    const auto err = read_image(path("err.exr"));
+    EXPECT_EQ(err.file_channels, 1);
+    EXPECT_EQ(err.pixels.cols, 64);
+}
+
+TEST_F(CompareCommand, HdrPairOnlyFlipAndHumanTable) {
+    cv::Mat a = synthetic(40, 40, 9, 0.0f) * 5.0, b = synthetic(40, 40, 10, 0.1f) * 5.0;
+    write_exr(path("a.exr"), a);
+    write_exr(path("b.exr"), b);
+    CompareArgs c = args(path("a.exr"), path("b.exr"));
+    c.metric = "flip";
+    c.json = true;
+    ASSERT_EQ(run(c), 0) << err_.str();
+    const auto j = nlohmann::json::parse(out_.str());
+    EXPECT_EQ(j["flip"]["mode"], "hdr");
+    EXPECT_TRUE(j["flip"].contains("num_exposures"));
+    EXPECT_FALSE(j.contains("ssim"));
+    EXPECT_FALSE(j.contains("psnr"));
+    c.json = false;
+    c.metric = "all";
+    ASSERT_EQ(run(c), 0) << err_.str();
+    EXPECT_NE(out_.str().find("HDR-FLIP exposures"), std::string::npos) << out_.str();
+    EXPECT_NE(out_.str().find("SSIM"), std::string::npos);
+}
+
+TEST_F(CompareCommand, MissingFile) {
+    write_png(path("a.png"), synthetic(16, 16, 1, 0));
+    EXPECT_EQ(run(args(path("a.png"), path("nope.png"))), kExitError);
+    EXPECT_NE(err_.str().find("error: " + path("nope.png") + ": file not found"), std::string::npos)
+        << err_.str();
+}
+
+TEST_F(CompareCommand, CorruptFile) {
+    write_png(path("a.png"), synthetic(16, 16, 1, 0));
+    {
+        std::ofstream f(path("bad.png"), std::ios::binary);
+        f << "\x89PNG\r\n\x1a\n this is not really a png";
+    }
+    EXPECT_EQ(run(args(path("a.png"), path("bad.png"))), kExitError);
+    EXPECT_NE(err_.str().find("error: " + path("bad.png") + ":"), std::string::npos) << err_.str();
+}
+
+TEST_F(CompareCommand, SizeMismatch) {
+    write_png(path("a.png"), synthetic(16, 16, 1, 0));
+    write_png(path("b.png"), synthetic(17, 16, 1, 0));
+    EXPECT_EQ(run(args(path("a.png"), path("b.png"))), kExitError);
+    EXPECT_NE(err_.str().find(path("b.png") + ": size 17x16 does not match"), std::string::npos)
+        << err_.str();
+}
+
+TEST_F(CompareCommand, ChannelMismatch) {
+    write_png(path("rgb.png"), synthetic(16, 16, 1, 0));
+    cv::Mat grey(16, 16, CV_32F, cv::Scalar(0.5));
+    write_png(path("grey.png"), grey);
+    EXPECT_EQ(run(args(path("rgb.png"), path("grey.png"))), kExitError);
+    EXPECT_NE(err_.str().find(path("grey.png") + ": has 1 channel(s) but"), std::string::npos)
+        << err_.str();
+}
+
+TEST_F(CompareCommand, NanAndInfPixels) {
+    cv::Mat a = synthetic(20, 10, 1, 0), b = a.clone();
+    b.at<cv::Vec3f>(3, 7)[1] = std::numeric_limits<float>::quiet_NaN();
+    b.at<cv::Vec3f>(8, 2)[0] = std::numeric_limits<float>::infinity();
+    write_exr(path("a.exr"), a);
+    write_exr(path("b.exr"), b);
+    EXPECT_EQ(run(args(path("a.exr"), path("b.exr"))), kExitError);
+    EXPECT_NE(err_.str().find(path("b.exr") + ": 2 non-finite value(s) (NaN/Inf), first at x=7, y=3"),
+              std::string::npos)
+        << err_.str();
+}
+
+TEST_F(CompareCommand, NegativeHdrValuesFailOrClamp) {
+    cv::Mat a = synthetic(20, 20, 1, 0), b = a.clone();
+    b.at<cv::Vec3f>(5, 5)[2] = -0.5f;
+    b.at<cv::Vec3f>(6, 5)[0] = -1.0f;
+    write_exr(path("a.exr"), a);
+    write_exr(path("b.exr"), b);
+    EXPECT_EQ(run(args(path("a.exr"), path("b.exr"))), kExitError);
+    EXPECT_NE(err_.str().find(path("b.exr") + ": 2 negative value(s)"), std::string::npos) << err_.str();
+    CompareArgs c = args(path("a.exr"), path("b.exr"));
+    c.clamp_negative = true;
+    c.json = true;
+    ASSERT_EQ(run(c), 0) << err_.str();
+    const auto j = nlohmann::json::parse(out_.str());
+    EXPECT_EQ(j["clamped_negative"]["test"].get<int>(), 2);
+    EXPECT_EQ(j["clamped_negative"]["reference"].get<int>(), 0);
+}
+
+TEST_F(CompareCommand, BadMetricIsUsageError) {
+    write_png(path("a.png"), synthetic(16, 16, 1, 0));
+    CompareArgs c = args(path("a.png"), path("a.png"));
+    c.metric = "lpips";
+    EXPECT_EQ(run(c), kExitError);
+    EXPECT_NE(err_.str().find("--metric"), std::string::npos);
+}
+
+TEST_F(CompareCommand, IdenticalImagesPerfectScores) {
+    write_png(path("a.png"), synthetic(32, 32, 1, 0.1f));
+    CompareArgs c = args(path("a.png"), path("a.png"));
+    c.json = true;
+    ASSERT_EQ(run(c), 0) << err_.str();
+    const auto j = nlohmann::json::parse(out_.str());
+    EXPECT_EQ(j["flip"]["mean"].get<double>(), 0.0);
+    EXPECT_DOUBLE_EQ(j["ssim"]["mean"].get<double>(), 1.0);
+    EXPECT_TRUE(j["psnr"]["db"].is_null()); // +inf
+}
+
+} // namespace
