@@ -9,6 +9,11 @@
 // Specs: `constant:R,G,B` (or `constant:V`), `studio`, `sky_sun`, `blender:NAME` (Debian
 // blender-data's studio-light panoramas, see scripts/setup.sh), or a path to an .exr/.hdr file.
 // Files: negatives (lossy EXR has ≈ −0.004) are clamped to 0 and counted; NaN/Inf are an InputError.
+// Sizes: constant:* is 64x32, studio and sky_sun are 1024x512 (procedural.h), files keep their size.
+// Channel order of `equirect` is R, G, B (not OpenCV's BGR), as read from the file.
+// Rotation (env_rotation): the panorama is turned by +rotation_deg about +Y (right-handed, so +90
+// moves what was at −Z to −X); a lookup in world direction d reads the panorama at R_y(−rotation_deg)·d:
+//   x' = cos(a)·x + sin(a)·z,  z' = −sin(a)·x + cos(a)·z,  a = −rotation_deg.
 #pragma once
 #include <opencv2/core.hpp>
 #include <string>

@@ -1,0 +1,225 @@
+// Built-in analytic scenes (see scene.h for the camera convention).
+//
+// Material defaults for the scenes that read the material options (`sphere`, `grazing`): those of
+// Material in scene.h — roughness 0.5, metallic 0, base_color 1,1,1 (a white dielectric: Lambert
+// with albedo 1 plus the F0 = 0.04 specular lobe). The multi-sphere scenes fix their own materials
+// (that is what they are for); see the catalog descriptions.
+#include "renderers/scenes/scene.h"
+
+#include <cmath>
+#include <cstdio>
+
+namespace iblcheck {
+
+namespace {
+
+struct SceneDef {
+    const char* name;
+    const char* description;
+    Scene (*build)(const OptionMap&);
+};
+
+Material material_from_options(const OptionMap& o) {
+    Material m;
+    m.roughness = float(o.get_double("roughness", m.roughness));
+    m.metallic = float(o.get_double("metallic", m.metallic));
+    m.base_color = o.get_vec3("base_color", m.base_color);
+    if (m.roughness < 0 || m.roughness > 1)
+        throw UsageError("option 'roughness': " + o.get_string("roughness", "") + " is outside [0, 1]");
+    if (m.metallic < 0 || m.metallic > 1)
+        throw UsageError("option 'metallic': " + o.get_string("metallic", "") + " is outside [0, 1]");
+    for (float c : {m.base_color.x, m.base_color.y, m.base_color.z})
+        if (c < 0 || c > 1)
+            throw UsageError("option 'base_color': " + o.get_string("base_color", "") + " is outside [0, 1]");
+    return m;
+}
+
+std::string fmt_r(float r) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.2g", double(r));
+    return buf;
+}
+
+Scene build_sphere(const OptionMap& o) {
+    Scene s;
+    s.name = "sphere";
+    s.width = s.height = 128;
+    s.camera.half_height = 1.1f; // radius-1 sphere fills 1/1.1 of the view
+    Sphere sp;
+    sp.center = {0, 0, 0};
+    sp.radius = 1;
+    sp.material = material_from_options(o);
+    s.spheres.push_back(sp);
+    s.labels.push_back("sphere r=" + fmt_r(sp.material.roughness));
+    return s;
+}
+
+Scene build_roughness_sweep(const OptionMap& o) {
+    Scene s;
+    s.name = "roughness_sweep";
+    s.width = 11 * 48;
+    s.height = 2 * 48;
+    s.camera.half_height = 1.0f; // 2 world units tall, 11 wide: one unit per sphere cell
+    Vec3f metal_color{0.95f, 0.64f, 0.54f};  // copper
+    Vec3f dielectric_color{0.5f, 0.5f, 0.5f}; // mid grey
+    for (int row = 0; row < 2; ++row) {
+        for (int i = 0; i <= 10; ++i) {
+            Sphere sp;
+            sp.center = {float(-5.0 + i), row == 0 ? 0.5f : -0.5f, 0};
+            sp.radius = 0.45f;
+            sp.material.roughness = float(i) / 10.0f;
+            sp.material.metallic = row == 0 ? 1.0f : 0.0f;
+            sp.material.base_color = row == 0 ? metal_color : dielectric_color;
+            s.spheres.push_back(sp);
+            s.labels.push_back(std::string(row == 0 ? "metal" : "dielectric") + " r=" + fmt_r(sp.material.roughness));
+        }
+    }
+    (void)o;
+    return s;
+}
+
+Scene furnace_row(const std::string& name, float metallic, const char* kind) {
+    Scene s;
+    s.name = name;
+    s.width = 5 * 64;
+    s.height = 64;
+    s.camera.half_height = 0.5f; // one unit tall, five wide
+    for (int i = 0; i < 5; ++i) {
+        Sphere sp;
+        sp.center = {float(-2.0 + i), 0, 0};
+        sp.radius = 0.45f;
+        sp.material.roughness = float(i) * 0.25f;
+        sp.material.metallic = metallic;
+        sp.material.base_color = {1, 1, 1};
+        s.spheres.push_back(sp);
+        s.labels.push_back(std::string(kind) + " r=" + fmt_r(sp.material.roughness));
+    }
+    return s;
+}
+
+Scene build_furnace(const OptionMap&) { return furnace_row("furnace", 1.0f, "metal"); }
+Scene build_furnace_dielectric(const OptionMap&) { return furnace_row("furnace_dielectric", 0.0f, "dielectric"); }
+
+Scene build_grazing(const OptionMap& o) {
+    Scene s;
+    s.name = "grazing";
+    s.width = s.height = 128;
+    // A close-up of the right limb of a radius-1 sphere: x in [0.74, 1.06], y in [-0.16, 0.16].
+    s.camera.eye = {0.9f, 0, 5};
+    s.camera.target = {0.9f, 0, 0};
+    s.camera.half_height = 0.16f;
+    Sphere sp;
+    sp.material = material_from_options(o);
+    s.spheres.push_back(sp);
+    s.labels.push_back("grazing r=" + fmt_r(sp.material.roughness));
+    return s;
+}
+
+const std::vector<SceneDef>& defs() {
+    static const std::vector<SceneDef> d = {
+        {"sphere",
+         "One radius-1 sphere filling 91% of a 128x128 orthographic view (half-height 1.1) looking -Z. "
+         "Material from options roughness/metallic/base_color; defaults r=0.5, metallic=0, base_color=1,1,1.",
+         build_sphere},
+        {"roughness_sweep",
+         "528x96: two rows of 11 spheres (48 px cells, radius 0.45 of a 1-unit cell), roughness 0, 0.1, ..., 1 "
+         "left to right. Top row metal (metallic=1, base_color=0.95,0.64,0.54 copper), bottom row dielectric "
+         "(metallic=0, base_color=0.5 grey). Materials are fixed; labels 'metal r=0.3', 'dielectric r=0.3'.",
+         build_roughness_sweep},
+        {"furnace",
+         "320x64: a row of 5 metal spheres (metallic=1, base_color=1, so F0=1), roughness 0, 0.25, 0.5, 0.75, 1 "
+         "(64 px cells, radius 0.45). Meant for constant:1, where each pixel equals the directional albedo E(n.v, a).",
+         build_furnace},
+        {"furnace_dielectric",
+         "320x64: as furnace but white dielectric (metallic=0, base_color=1): in constant:1 each pixel equals "
+         "1 (Lambert) + the F0=0.04 specular albedo.",
+         build_furnace_dielectric},
+        {"grazing",
+         "128x128 orthographic close-up of the limb of a radius-1 sphere (view x in [0.74,1.06], y in [-0.16,0.16]): "
+         "most covered pixels have n.v < 0.6, many near 0. Material options as for sphere.",
+         build_grazing},
+    };
+    return d;
+}
+
+} // namespace
+
+std::vector<SceneInfo> scene_catalog() {
+    std::vector<SceneInfo> out;
+    for (const auto& d : defs()) out.push_back({d.name, d.description});
+    return out;
+}
+
+const std::vector<std::string>& scene_option_keys() {
+    static const std::vector<std::string> keys = {"roughness", "metallic", "base_color"};
+    return keys;
+}
+
+Scene build_scene(const std::string& name, const OptionMap& options) {
+    for (const auto& d : defs())
+        if (name == d.name) return d.build(options);
+    std::string valid;
+    for (const auto& d : defs()) valid += (valid.empty() ? "" : ", ") + std::string(d.name);
+    throw UsageError("unknown scene '" + name + "'; valid scenes: " + valid);
+}
+
+Hit intersect(const Scene& scene, Vec3f origin, Vec3f dir) {
+    Hit best;
+    double best_t = INFINITY;
+    for (size_t i = 0; i < scene.spheres.size(); ++i) {
+        const Sphere& s = scene.spheres[i];
+        // |o + t d - c|^2 = r^2 with |d| = 1: t^2 + 2 b t + c = 0
+        double ox = double(origin.x) - s.center.x, oy = double(origin.y) - s.center.y,
+               oz = double(origin.z) - s.center.z;
+        double b = ox * dir.x + oy * dir.y + oz * dir.z;
+        double c = ox * ox + oy * oy + oz * oz - double(s.radius) * s.radius;
+        double disc = b * b - c;
+        if (disc < 0) continue;
+        double sq = std::sqrt(disc);
+        double t = -b - sq;
+        if (t <= 1e-6) t = -b + sq;
+        if (t <= 1e-6 || t >= best_t) continue;
+        best_t = t;
+        best.hit = true;
+        best.sphere = int(i);
+        best.t = float(t);
+        double px = ox + t * dir.x, py = oy + t * dir.y, pz = oz + t * dir.z;
+        double inv = 1.0 / std::sqrt(px * px + py * py + pz * pz);
+        best.normal = {float(px * inv), float(py * inv), float(pz * inv)};
+        best.position = {float(origin.x + t * dir.x), float(origin.y + t * dir.y), float(origin.z + t * dir.z)};
+    }
+    return best;
+}
+
+void camera_ray(const Scene& scene, int width, int height, double px, double py, Vec3f& origin, Vec3f& dir) {
+    const Camera& c = scene.camera;
+    auto normalize = [](double x, double y, double z, double out[3]) {
+        double l = std::sqrt(x * x + y * y + z * z);
+        out[0] = x / l, out[1] = y / l, out[2] = z / l;
+    };
+    double f[3], r[3], u[3];
+    normalize(double(c.target.x) - c.eye.x, double(c.target.y) - c.eye.y, double(c.target.z) - c.eye.z, f);
+    // right = forward x world_up
+    normalize(f[1] * c.world_up.z - f[2] * c.world_up.y, f[2] * c.world_up.x - f[0] * c.world_up.z,
+              f[0] * c.world_up.y - f[1] * c.world_up.x, r);
+    // up = right x forward
+    u[0] = r[1] * f[2] - r[2] * f[1];
+    u[1] = r[2] * f[0] - r[0] * f[2];
+    u[2] = r[0] * f[1] - r[1] * f[0];
+    double nx = 2.0 * px / width - 1.0, ny = 1.0 - 2.0 * py / height;
+    if (c.orthographic) {
+        double hh = c.half_height, hw = hh * double(width) / height;
+        origin = {float(c.eye.x + r[0] * nx * hw + u[0] * ny * hh), float(c.eye.y + r[1] * nx * hw + u[1] * ny * hh),
+                  float(c.eye.z + r[2] * nx * hw + u[2] * ny * hh)};
+        dir = {float(f[0]), float(f[1]), float(f[2])};
+    } else {
+        double t = std::tan(double(c.fov_y_deg) * 3.14159265358979323846 / 360.0);
+        double ax = nx * t * double(width) / height, ay = ny * t;
+        double d[3];
+        normalize(f[0] + r[0] * ax + u[0] * ay, f[1] + r[1] * ax + u[1] * ay, f[2] + r[2] * ax + u[2] * ay, d);
+        origin = c.eye;
+        dir = {float(d[0]), float(d[1]), float(d[2])};
+    }
+}
+
+} // namespace iblcheck

@@ -1,0 +1,312 @@
+// Scenes (renderers/scenes) and environments (renderers/environments): the shared inputs of every method.
+#include <OpenImageIO/imageio.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <limits>
+
+#include "renderers/environments/environment.h"
+#include "renderers/environments/procedural.h"
+#include "renderers/scenes/scene.h"
+
+using namespace iblcheck;
+namespace fs = std::filesystem;
+
+namespace {
+constexpr double kPi = 3.14159265358979323846;
+
+fs::path temp_file(const std::string& name) {
+    fs::path dir = fs::temp_directory_path() / ("iblcheck_test_env_" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    return dir / name;
+}
+
+void write_exr(const fs::path& path, const cv::Mat& img) {
+    auto out = OIIO::ImageOutput::create(path.string());
+    ASSERT_TRUE(out);
+    OIIO::ImageSpec spec(img.cols, img.rows, 3, OIIO::TypeDesc::FLOAT);
+    ASSERT_TRUE(out->open(path.string(), spec));
+    ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, img.ptr<float>(0)));
+    out->close();
+}
+
+double len(Vec3f v) { return std::sqrt(double(v.x) * v.x + double(v.y) * v.y + double(v.z) * v.z); }
+} // namespace
+
+// ---------------------------------------------------------------- environments
+
+TEST(Environment, DirectionUvRoundTrip) {
+    for (int j = 1; j < 40; ++j)
+        for (int i = 0; i < 80; ++i) {
+            float u = (i + 0.5f) / 80, v = j / 40.0f;
+            float d[3];
+            uv_to_direction(u, v, d);
+            EXPECT_NEAR(std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]), 1.0, 1e-6);
+            float u2, v2;
+            direction_to_uv(d, u2, v2);
+            EXPECT_NEAR(u2, u, 2e-6) << i << "," << j;
+            EXPECT_NEAR(v2, v, 2e-6) << i << "," << j;
+        }
+}
+
+TEST(Environment, MinusZIsThePanoramaCentre) {
+    float d[3] = {0, 0, -1}, u, v;
+    direction_to_uv(d, u, v);
+    EXPECT_NEAR(u, 0.5, 1e-7);
+    EXPECT_NEAR(v, 0.5, 1e-7);
+    float up[3] = {0, 1, 0};
+    direction_to_uv(up, u, v);
+    EXPECT_NEAR(v, 0.0, 1e-7);
+    // +X is a quarter turn right of the centre: u = 0.75.
+    float px[3] = {1, 0, 0};
+    direction_to_uv(px, u, v);
+    EXPECT_NEAR(u, 0.75, 1e-7);
+    EXPECT_NEAR(v, 0.5, 1e-7);
+}
+
+TEST(Environment, ConstantSamplesTheConstant) {
+    Environment e = load_environment("constant:0.25,0.5,2");
+    EXPECT_EQ(e.equirect.cols, 2 * e.equirect.rows);
+    for (float dy : {-1.0f, -0.3f, 0.0f, 0.7f, 1.0f}) {
+        float d[3] = {std::sqrt(1 - dy * dy), dy, 0}, c[3];
+        sample_bilinear(e, d, c);
+        EXPECT_FLOAT_EQ(c[0], 0.25f);
+        EXPECT_FLOAT_EQ(c[1], 0.5f);
+        EXPECT_FLOAT_EQ(c[2], 2.0f);
+    }
+    Environment one = load_environment("constant:1");
+    float d[3] = {0, 0, -1}, c[3];
+    sample_bilinear(one, d, c);
+    EXPECT_FLOAT_EQ(c[0], 1.0f);
+    EXPECT_EQ(one.content_hash.size(), 16u);
+    EXPECT_NE(one.content_hash, e.content_hash);
+}
+
+TEST(Environment, BilinearAtPixelCentresAndWrap) {
+    cv::Mat img(8, 16, CV_32FC3, cv::Scalar(0, 0, 0));
+    img.at<cv::Vec3f>(4, 0) = {1, 1, 1};
+    img.at<cv::Vec3f>(4, 15) = {3, 3, 3};
+    fs::path p = temp_file("wrap.exr");
+    write_exr(p, img);
+    Environment e = load_environment(p.string());
+    float d[3], c[3];
+    uv_to_direction(0.5f / 16, 4.5f / 8, d); // centre of pixel (0,4)
+    sample_bilinear(e, d, c);
+    EXPECT_NEAR(c[0], 1.0, 1e-5);
+    uv_to_direction(0.0f, 4.5f / 8, d); // the seam: halfway between pixel 15 and pixel 0
+    sample_bilinear(e, d, c);
+    EXPECT_NEAR(c[0], 2.0, 1e-5);
+    // Rotation: +90 deg about +Y brings the seam content (direction +Z) to +X... lookup at R(-90)·d.
+    e.rotation_deg = 90;
+    float px[3] = {1, 0, 0};
+    // R_y(-90)·(+X) = +Z, which is the seam (u = 1 or 0), v = 0.5 -> between rows 3 and 4: half of 2.
+    sample_bilinear(e, px, c);
+    EXPECT_NEAR(c[0], 1.0, 1e-5);
+}
+
+TEST(Environment, NaNIsAnInputErrorWithCountAndLocation) {
+    cv::Mat img(16, 32, CV_32FC3, cv::Scalar(1, 1, 1));
+    img.at<cv::Vec3f>(3, 7)[1] = std::numeric_limits<float>::quiet_NaN();
+    img.at<cv::Vec3f>(5, 9)[0] = std::numeric_limits<float>::infinity();
+    fs::path p = temp_file("nan.exr");
+    write_exr(p, img);
+    try {
+        load_environment(p.string());
+        FAIL() << "expected InputError";
+    } catch (const InputError& e) {
+        std::string m = e.what();
+        EXPECT_NE(m.find("2 non-finite"), std::string::npos) << m;
+        EXPECT_NE(m.find("(7, 3)"), std::string::npos) << m;
+    }
+}
+
+TEST(Environment, NegativesAreClampedAndCounted) {
+    cv::Mat img(16, 32, CV_32FC3, cv::Scalar(0.5, 0.5, 0.5));
+    img.at<cv::Vec3f>(2, 2) = {-0.004f, 0.5f, -1.0f};
+    img.at<cv::Vec3f>(8, 30)[1] = -0.25f;
+    fs::path p = temp_file("neg.exr");
+    write_exr(p, img);
+    Environment e = load_environment(p.string());
+    EXPECT_EQ(e.negatives_clamped, 3);
+    EXPECT_EQ(e.equirect.at<cv::Vec3f>(2, 2)[0], 0.0f);
+    EXPECT_EQ(e.equirect.at<cv::Vec3f>(2, 2)[2], 0.0f);
+    EXPECT_EQ(e.equirect.at<cv::Vec3f>(8, 30)[1], 0.0f);
+    double mn;
+    cv::minMaxLoc(e.equirect.reshape(1), &mn);
+    EXPECT_GE(mn, 0.0);
+}
+
+TEST(Environment, NonEquirectAspectIsAnInputError) {
+    cv::Mat img(16, 16, CV_32FC3, cv::Scalar(1, 1, 1));
+    fs::path p = temp_file("square.exr");
+    write_exr(p, img);
+    EXPECT_THROW(load_environment(p.string()), InputError);
+    EXPECT_THROW(load_environment(temp_file("missing.exr").string()), InputError);
+}
+
+TEST(Environment, UnknownSpecIsAUsageError) {
+    EXPECT_THROW(load_environment("moonlight"), UsageError);
+    EXPECT_THROW(load_environment("blender:mars"), UsageError);
+    EXPECT_THROW(load_environment("constant:x"), UsageError);
+    try {
+        load_environment("moonlight");
+    } catch (const UsageError& e) {
+        EXPECT_NE(std::string(e.what()).find("sky_sun"), std::string::npos);
+    }
+}
+
+TEST(Environment, ProceduralStudioAndSkySun) {
+    Environment st = load_environment("studio");
+    EXPECT_EQ(st.equirect.cols, 1024);
+    EXPECT_EQ(st.equirect.rows, 512);
+    double mn, mx;
+    cv::minMaxLoc(st.equirect.reshape(1), &mn, &mx);
+    EXPECT_GE(mn, 0.025);
+    EXPECT_GE(mx, 40.0);
+    EXPECT_LE(mx, 50.001);
+    EXPECT_EQ(load_environment("studio").content_hash, st.content_hash); // deterministic
+
+    Environment sky = load_environment("sky_sun");
+    EXPECT_EQ(sky.equirect.cols, 1024);
+    // The sun: its centre direction reads the sun's radiance; the zenith reads the sky.
+    double el = procedural::kSunElevationDeg * kPi / 180, az = procedural::kSunAzimuthDeg * kPi / 180;
+    float sun[3] = {float(std::cos(el) * std::sin(az)), float(std::sin(el)), float(-std::cos(el) * std::cos(az))};
+    float c[3];
+    sample_bilinear(sky, sun, c);
+    EXPECT_NEAR(c[0], procedural::kSunRadiance[0], 1.0);
+    EXPECT_GT(sun[2], 0.5f); // in front of the camera (+Z side)
+    float up[3] = {0, 1, 0}, down[3] = {0, -1, 0}, zs[3], gr[3];
+    sample_bilinear(sky, up, zs);
+    sample_bilinear(sky, down, gr);
+    EXPECT_NEAR(zs[2], procedural::kSkyZenith[2], 0.01);
+    EXPECT_LT(gr[0] + gr[1] + gr[2], 0.5 * (zs[0] + zs[1] + zs[2]));
+    EXPECT_GT(c[1] / zs[1], 5e4);
+}
+
+TEST(Environment, BlenderSunriseLoadsWithClampedNegatives) {
+    Environment e;
+    try {
+        e = load_environment("blender:sunrise");
+    } catch (const InputError& err) {
+        GTEST_SKIP() << "blender:sunrise not present (" << err.what() << ")";
+    }
+    EXPECT_EQ(e.equirect.cols, 2 * e.equirect.rows);
+    EXPECT_GT(e.negatives_clamped, 0);
+    double mn;
+    cv::minMaxLoc(e.equirect.reshape(1), &mn);
+    EXPECT_GE(mn, 0.0);
+    EXPECT_FALSE(e.source_path.empty());
+}
+
+// ---------------------------------------------------------------- scenes
+
+TEST(Scene, IntersectHitsAndMisses) {
+    Scene s = build_scene("sphere", {});
+    ASSERT_EQ(s.spheres.size(), 1u);
+    Hit h = intersect(s, {0, 0, 5}, {0, 0, -1});
+    ASSERT_TRUE(h.hit);
+    EXPECT_NEAR(h.t, 4.0, 1e-5);
+    EXPECT_NEAR(h.normal.z, 1.0, 1e-6);
+    EXPECT_FALSE(intersect(s, {1.01f, 0, 5}, {0, 0, -1}).hit);
+    EXPECT_FALSE(intersect(s, {0, 0, 5}, {0, 0, 1}).hit); // pointing away
+    Hit g = intersect(s, {0.6f, 0.0f, 5}, {0, 0, -1});
+    ASSERT_TRUE(g.hit);
+    EXPECT_NEAR(g.normal.x, 0.6, 1e-6);
+    EXPECT_NEAR(g.normal.z, 0.8, 1e-6);
+}
+
+TEST(Scene, NormalsAreUnitOverTheImage) {
+    for (const auto& info : scene_catalog()) {
+        Scene s = build_scene(info.name, {});
+        int hits = 0;
+        for (int y = 0; y < s.height; y += 3)
+            for (int x = 0; x < s.width; x += 3) {
+                Vec3f o, d;
+                camera_ray(s, s.width, s.height, x + 0.5, y + 0.5, o, d);
+                EXPECT_NEAR(len(d), 1.0, 1e-6);
+                Hit h = intersect(s, o, d);
+                if (!h.hit) continue;
+                ++hits;
+                EXPECT_NEAR(len(h.normal), 1.0, 1e-6);
+                EXPECT_GT(-(h.normal.x * d.x + h.normal.y * d.y + h.normal.z * d.z), 0.0) << info.name;
+            }
+        EXPECT_GT(hits, 0) << info.name;
+    }
+}
+
+TEST(Scene, CameraConvention) {
+    Scene s = build_scene("sphere", {});
+    Vec3f o, d;
+    camera_ray(s, 128, 128, 0, 0, o, d); // top-left corner: ndc (-1, 1)
+    EXPECT_NEAR(o.x, -1.1, 1e-6);
+    EXPECT_NEAR(o.y, 1.1, 1e-6);
+    EXPECT_NEAR(o.z, 5.0, 1e-6);
+    EXPECT_NEAR(d.z, -1.0, 1e-7);
+    camera_ray(s, 128, 128, 64, 64, o, d);
+    EXPECT_NEAR(o.x, 0.0, 1e-6);
+    EXPECT_NEAR(o.y, 0.0, 1e-6);
+}
+
+TEST(Scene, UnknownSceneIsAUsageErrorListingTheValidOnes) {
+    try {
+        build_scene("teapot", {});
+        FAIL();
+    } catch (const UsageError& e) {
+        std::string m = e.what();
+        EXPECT_NE(m.find("teapot"), std::string::npos);
+        EXPECT_NE(m.find("roughness_sweep"), std::string::npos);
+        EXPECT_NE(m.find("furnace"), std::string::npos);
+    }
+}
+
+TEST(Scene, MaterialOptions) {
+    OptionMap o;
+    o.set("roughness", "0.3");
+    o.set("metallic", "1");
+    o.set("base_color", "0.9,0.5,0.1");
+    Scene s = build_scene("sphere", o);
+    EXPECT_FLOAT_EQ(s.spheres[0].material.roughness, 0.3f);
+    EXPECT_FLOAT_EQ(s.spheres[0].material.metallic, 1.0f);
+    EXPECT_FLOAT_EQ(s.spheres[0].material.base_color.z, 0.1f);
+    Scene d = build_scene("sphere", {});
+    EXPECT_FLOAT_EQ(d.spheres[0].material.roughness, 0.5f);
+    EXPECT_FLOAT_EQ(d.spheres[0].material.metallic, 0.0f);
+    OptionMap bad;
+    bad.set("roughness", "1.5");
+    EXPECT_THROW(build_scene("sphere", bad), UsageError);
+    EXPECT_EQ(scene_option_keys().size(), 3u);
+}
+
+TEST(Scene, RoughnessSweepLayout) {
+    Scene s = build_scene("roughness_sweep", {});
+    ASSERT_EQ(s.spheres.size(), 22u);
+    ASSERT_EQ(s.labels.size(), 22u);
+    EXPECT_EQ(s.width, 528);
+    EXPECT_EQ(s.height, 96);
+    for (int i = 0; i < 22; ++i) {
+        EXPECT_NEAR(s.spheres[i].material.roughness, (i % 11) * 0.1, 1e-6);
+        EXPECT_FLOAT_EQ(s.spheres[i].material.metallic, i < 11 ? 1.0f : 0.0f);
+    }
+    EXPECT_EQ(s.labels[3], "metal r=0.3");
+    EXPECT_EQ(s.labels[11 + 10], "dielectric r=1");
+    // The centre pixel of each 48 px cell hits its sphere.
+    for (int i = 0; i < 22; ++i) {
+        Vec3f o, d;
+        camera_ray(s, s.width, s.height, (i % 11) * 48 + 24, (i / 11) * 48 + 24, o, d);
+        Hit h = intersect(s, o, d);
+        ASSERT_TRUE(h.hit);
+        EXPECT_EQ(h.sphere, i);
+    }
+}
+
+TEST(Scene, FurnaceLayout) {
+    Scene s = build_scene("furnace", {});
+    ASSERT_EQ(s.spheres.size(), 5u);
+    for (int i = 0; i < 5; ++i) {
+        EXPECT_FLOAT_EQ(s.spheres[i].material.roughness, 0.25f * i);
+        EXPECT_FLOAT_EQ(s.spheres[i].material.metallic, 1.0f);
+        EXPECT_FLOAT_EQ(s.spheres[i].material.base_color.x, 1.0f);
+    }
+    EXPECT_FLOAT_EQ(build_scene("furnace_dielectric", {}).spheres[2].material.metallic, 0.0f);
+}
