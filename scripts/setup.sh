@@ -8,7 +8,7 @@ PACKAGES=(
   cmake g++ pkg-config
   libvulkan-dev mesa-vulkan-drivers vulkan-validationlayers vulkan-tools
   glslang-dev glslang-tools spirv-tools
-  libopenimageio-dev
+  libopenimageio-dev openimageio-tools
   libopencv-dev libopencv-contrib-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   nlohmann-json3-dev libcli11-dev libfmt-dev

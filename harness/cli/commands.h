@@ -1,0 +1,14 @@
+// Each subcommand registers itself on the CLI11 app and writes its exit code (errors.h) into
+// `exit_code`. Exceptions derived from iblcheck::Error escaping a callback become exit 2 in main().
+#pragma once
+#include <CLI/CLI.hpp>
+
+namespace iblcheck::cli {
+
+void register_doctor_command(CLI::App& app, int& exit_code);
+void register_list_command(CLI::App& app, int& exit_code);
+void register_render_command(CLI::App& app, int& exit_code);
+void register_run_commands(CLI::App& app, int& exit_code); // run, bless, bisect
+void register_report_command(CLI::App& app, int& exit_code);
+
+} // namespace iblcheck::cli

@@ -1,0 +1,40 @@
+// `iblcheck doctor`: what Vulkan driver the harness will use and whether it has what we need.
+#include <fmt/core.h>
+
+#include "commands.h"
+#include "harness/common/errors.h"
+#include "renderers/vulkan/context.h"
+
+namespace iblcheck::cli {
+
+void register_doctor_command(CLI::App& app, int& exit_code) {
+    auto* cmd = app.add_subcommand("doctor", "Print the Vulkan driver, its versions and the features iblcheck uses");
+    static std::string device;
+    static bool validation = false;
+    cmd->add_option("--device", device, "Substring of the device/driver name (default: lavapipe)");
+    cmd->add_flag("--validation", validation, "Also check that the Khronos validation layer loads");
+    cmd->callback([&exit_code] {
+        vk::ContextOptions opt;
+        opt.device = device;
+        opt.validation = validation;
+        vk::Context ctx(opt); // throws EnvironmentError with a one-line fix when there is no driver
+        const auto& i = ctx.info();
+        fmt::print("device:          {} ({})\n", i.device_name, i.device_type);
+        fmt::print("driver:          {}\n", i.driver_name);
+        fmt::print("driver info:     {}\n", i.driver_info);
+        fmt::print("mesa version:    {}\n", i.mesa_version.empty() ? "n/a" : i.mesa_version);
+        fmt::print("llvm version:    {}\n", i.llvm_version.empty() ? "n/a" : i.llvm_version);
+        fmt::print("vulkan api:      {}\n", i.api_version);
+        fmt::print("shaderFloat16:   {}\n", i.shader_float16 ? "yes" : "no (precision=mediump falls back to fp32)");
+        fmt::print("16-bit storage:  {}\n", i.storage_16bit ? "yes" : "no");
+        fmt::print("timestamps:      {} (period {} ns)\n", i.timestamps ? "yes" : "no", i.timestamp_period_ns);
+        fmt::print("validation:      {}\n", i.validation ? "on" : "off");
+        fmt::print("shader folder:   {}\n", vk::shader_dir().string());
+        fmt::print("all devices:\n");
+        for (const auto& d : i.available_devices) fmt::print("  {}\n", d);
+        exit_code = i.timestamps ? kExitPass : kExitError;
+        if (!i.timestamps) fmt::print(stderr, "error: {}: no timestamp queries; per-pass timings need them\n", i.device_name);
+    });
+}
+
+} // namespace iblcheck::cli

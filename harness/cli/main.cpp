@@ -1,0 +1,35 @@
+// iblcheck: image-diff validation harness for mobile IBL shaders.
+// Exit codes (DESIGN.md): 0 pass, 1 regression, 2 usage/input/environment error,
+// 125 (bisect only) cannot test this commit.
+#include <CLI/CLI.hpp>
+#include <fmt/core.h>
+
+#include "commands.h"
+#include "compare_command.h"
+#include "harness/common/errors.h"
+
+int main(int argc, char** argv) {
+    CLI::App app{"iblcheck — image-diff validation harness for mobile IBL shaders"};
+    app.require_subcommand(1);
+    int exit_code = iblcheck::kExitPass;
+    iblcheck::cli::register_doctor_command(app, exit_code);
+    iblcheck::cli::register_list_command(app, exit_code);
+    iblcheck::cli::register_render_command(app, exit_code);
+    iblcheck::register_compare_command(app, exit_code);
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        int rc = app.exit(e);
+        return rc == 0 ? 0 : iblcheck::kExitError;
+    } catch (const iblcheck::ShaderCompileError& e) {
+        fmt::print(stderr, "error: shader compile failed:\n{}\n", e.what());
+        return iblcheck::kExitError;
+    } catch (const iblcheck::Error& e) {
+        fmt::print(stderr, "error: {}\n", e.what());
+        return iblcheck::kExitError;
+    } catch (const std::exception& e) {
+        fmt::print(stderr, "error: internal: {}\n", e.what());
+        return iblcheck::kExitError;
+    }
+    return exit_code;
+}

@@ -1,0 +1,102 @@
+// `iblcheck render` and `iblcheck list`.
+#include <fmt/core.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "commands.h"
+#include "harness/common/errors.h"
+#include "metrics/display_transform.h"
+#include "metrics/image_io.h"
+#include "renderers/environments/environment.h"
+#include "renderers/renderer.h"
+#include "renderers/scenes/scene.h"
+
+namespace iblcheck::cli {
+
+namespace {
+void parse_size(const std::string& s, int& w, int& h) {
+    if (s.empty()) return;
+    if (std::sscanf(s.c_str(), "%dx%d", &w, &h) != 2 || w < 1 || h < 1 || w > 8192 || h > 8192)
+        throw UsageError("--size '" + s + "' is not WxH (1..8192)");
+}
+} // namespace
+
+void register_list_command(CLI::App& app, int& exit_code) {
+    auto* cmd = app.add_subcommand("list", "List scenes, methods, environments and options");
+    cmd->callback([&exit_code] {
+        fmt::print("scenes:\n");
+        for (auto& s : scene_catalog()) fmt::print("  {:<20} {}\n", s.name, s.description);
+        fmt::print("methods:\n");
+        for (auto& m : method_catalog()) fmt::print("  {:<20} {}\n", m.name, m.description);
+        fmt::print("environments:\n");
+        for (auto& e : environment_catalog()) fmt::print("  {:<20} {}\n", e.spec, e.description);
+        fmt::print("options (--set key=value; methods that read them):\n");
+        for (auto& o : option_catalog())
+            fmt::print("  {:<22} default {:<10} values {:<34} [{}] {}\n", o.key, o.default_value, o.values, o.methods,
+                       o.description);
+        exit_code = kExitPass;
+    });
+}
+
+void register_render_command(CLI::App& app, int& exit_code) {
+    auto* cmd = app.add_subcommand("render", "Render a scene with one method");
+    static std::string scene = "sphere", method = "mobile", env = "studio", size, out, json_out, device;
+    static std::vector<std::string> sets;
+    static bool force = false;
+    cmd->add_option("--scene", scene, "Scene name (iblcheck list)")->capture_default_str();
+    cmd->add_option("--method", method, "mobile | sampled | reference")->capture_default_str();
+    cmd->add_option("--env", env, "Environment spec (iblcheck list)")->capture_default_str();
+    cmd->add_option("--size", size, "Image size WxH (default: the scene's)");
+    cmd->add_option("--set", sets, "Option key=value (repeatable)");
+    cmd->add_option("--out", out, "Output EXR (a tone-mapped PNG is written beside it)");
+    cmd->add_option("--json", json_out, "Write timings and provenance as JSON to this file ('-' for stdout)");
+    cmd->add_option("--device", device, "Vulkan device/driver name substring (default: lavapipe)");
+    cmd->add_flag("--force", force, "Overwrite existing output files");
+    cmd->callback([&exit_code] {
+        TestSpec spec;
+        spec.scene = scene;
+        spec.method = method;
+        spec.env = env;
+        parse_size(size, spec.width, spec.height);
+        for (auto& s : sets) spec.options.set_from_string(s);
+        namespace fs = std::filesystem;
+        fs::path png = fs::path(out).replace_extension(".png");
+        if (!out.empty() && !force)
+            for (const fs::path& p : {fs::path(out), png})
+                if (fs::exists(p)) throw UsageError(p.string() + ": exists; pass --force to overwrite");
+        vk::ContextOptions vo;
+        vo.device = device;
+        Renderer renderer(vo);
+        RenderResult r = renderer.render(spec);
+        double total = 0;
+        for (auto& t : r.timings) {
+            fmt::print("{:<20} {:9.3f} ms  {}{}\n", t.name, t.ms, t.gpu ? "gpu" : "cpu", t.precompute ? "  precompute" : "");
+            total += t.ms;
+        }
+        fmt::print("{:<20} {:9.3f} ms\n", "total", total);
+        fmt::print("texture samples/px  {:.2f}\n", r.texture_fetches_per_pixel);
+        if (!out.empty()) {
+            write_exr(out, r.image);
+            write_png(png.string(), display_transform(r.image));
+            fmt::print("wrote {} and {}\n", out, png.string());
+        }
+        if (!json_out.empty()) {
+            nlohmann::json j;
+            j["provenance"] = r.provenance;
+            j["texture_fetches_per_pixel"] = r.texture_fetches_per_pixel;
+            for (auto& t : r.timings)
+                j["timings"].push_back({{"pass", t.name}, {"ms", t.ms}, {"gpu", t.gpu}, {"precompute", t.precompute}});
+            if (json_out == "-") {
+                fmt::print("{}\n", j.dump(2));
+            } else {
+                std::ofstream f(json_out);
+                if (!f) throw InputError(json_out + ": cannot write");
+                f << j.dump(2) << "\n";
+            }
+        }
+        exit_code = kExitPass;
+    });
+}
+
+} // namespace iblcheck::cli

@@ -1,0 +1,68 @@
+#include "gpu_scene.h"
+
+#include <cmath>
+#include <cstring>
+
+namespace iblcheck {
+
+namespace {
+Vec3f sub(Vec3f a, Vec3f b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+Vec3f cross(Vec3f a, Vec3f b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
+Vec3f normalize(Vec3f a) {
+    float l = std::sqrt(a.x * a.x + a.y * a.y + a.z * a.z);
+    return {a.x / l, a.y / l, a.z / l};
+}
+void put(float* p, Vec3f v, float w) {
+    p[0] = v.x;
+    p[1] = v.y;
+    p[2] = v.z;
+    p[3] = w;
+}
+} // namespace
+
+vk::Buffer upload_scene(vk::Context& ctx, const Scene& scene) {
+    const size_t header = 5 * 16, per_sphere = 3 * 16;
+    vk::Buffer buf = ctx.create_buffer(header + per_sphere * std::max<size_t>(1, scene.spheres.size()));
+    auto* f = buf.as<float>();
+    const Camera& c = scene.camera;
+    // scene.h: forward = normalize(target − eye), right = normalize(forward × world_up), up = right × forward.
+    Vec3f fwd = normalize(sub(c.target, c.eye));
+    Vec3f right = normalize(cross(fwd, c.world_up));
+    Vec3f up = cross(right, fwd);
+    put(f + 0, c.eye, c.orthographic ? 1.0f : 0.0f);
+    put(f + 4, fwd, c.half_height);
+    put(f + 8, right, float(std::tan(c.fov_y_deg * 3.14159265358979323846 / 360.0)));
+    put(f + 12, up, 0);
+    uint32_t count = uint32_t(scene.spheres.size());
+    std::memcpy(f + 16, &count, 4);
+    float* s = f + 20;
+    for (const Sphere& sp : scene.spheres) {
+        put(s, sp.center, sp.radius);
+        put(s + 4, sp.material.base_color, sp.material.metallic);
+        s[8] = sp.material.roughness;
+        s[9] = sp.bump_amplitude;
+        s[10] = sp.bump_frequency;
+        s[11] = sp.bump_phase;
+        s += 12;
+    }
+    return buf;
+}
+
+double read_back_image(const vk::Buffer& buf, int width, int height, cv::Mat& rgb) {
+    rgb.create(height, width, CV_32FC3);
+    const float* src = static_cast<const float*>(buf.mapped);
+    double coverage = 0;
+    for (int y = 0; y < height; ++y) {
+        float* row = rgb.ptr<float>(y);
+        for (int x = 0; x < width; ++x) {
+            const float* p = src + 4 * (size_t(y) * width + x);
+            row[3 * x] = p[0];
+            row[3 * x + 1] = p[1];
+            row[3 * x + 2] = p[2];
+            coverage += p[3];
+        }
+    }
+    return coverage / (double(width) * height);
+}
+
+} // namespace iblcheck

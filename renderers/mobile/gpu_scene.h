@@ -1,0 +1,12 @@
+// The scene as the shaders read it (scene.glsl's SceneBuffer, std430).
+#pragma once
+#include <opencv2/core.hpp>
+
+#include "renderers/scenes/scene.h"
+#include "renderers/vulkan/context.h"
+
+namespace iblcheck {
+vk::Buffer upload_scene(vk::Context& ctx, const Scene& scene);
+// Reads back a vec4 image (rgb + coverage) into CV_32FC3 and returns the mean coverage.
+double read_back_image(const vk::Buffer& buf, int width, int height, cv::Mat& rgb);
+}

@@ -1,0 +1,169 @@
+#include "ibl_precompute.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstring>
+
+#include "harness/common/errors.h"
+
+namespace iblcheck {
+
+namespace {
+
+constexpr VkDescriptorType kSampled = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+constexpr VkDescriptorType kStorageImage = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+constexpr VkDescriptorType kStorageBuffer = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+
+uint32_t groups(uint32_t n, uint32_t local = 8) { return (n + local - 1) / local; }
+
+VkFormat storage_format(const std::string& storage, bool native_r11g11b10) {
+    if (storage == "rgba32f") return VK_FORMAT_R32G32B32A32_SFLOAT;
+    if (storage == "rgba16f") return VK_FORMAT_R16G16B16A16_SFLOAT;
+    if (storage == "rgbm8") return VK_FORMAT_R8G8B8A8_UNORM;
+    if (storage == "r11g11b10") return native_r11g11b10 ? VK_FORMAT_B10G11R11_UFLOAT_PACK32 : VK_FORMAT_R16G16B16A16_SFLOAT;
+    throw UsageError("option 'storage': unknown value '" + storage + "'; valid: rgba16f, rgba32f, rgbm8, r11g11b10");
+}
+
+} // namespace
+
+std::string mip_mapping_define(const std::string& name) {
+    if (name == "ue4") return "0";
+    if (name == "filament") return "1";
+    if (name == "origin") return "2";
+    throw UsageError("option 'mip_mapping': unknown value '" + name + "'; valid: ue4, filament, origin");
+}
+
+vk::Defines storage_defines(const PrecomputeSettings& s, bool native_r11g11b10) {
+    vk::Defines d;
+    const char* id = s.storage == "rgba32f" ? "0" : s.storage == "rgba16f" ? "1" : s.storage == "rgbm8" ? "2" : "3";
+    d["STORAGE"] = id;
+    if (s.storage == "rgbm8") d["RGBM_RANGE"] = std::to_string(s.rgbm_range);
+    if (s.storage == "r11g11b10" && native_r11g11b10) d["STORAGE_NATIVE_R11G11B10"] = "1";
+    return d;
+}
+
+IblResources run_precompute(GpuSession& gpu, const Environment& env, const PrecomputeSettings& s,
+                            std::vector<PassTiming>& timings) {
+    vk::Context& ctx = gpu.ctx();
+    if (s.cube_size < 8 || s.cube_size > 2048 || (s.cube_size & (s.cube_size - 1)))
+        throw UsageError("option 'cube_size': " + std::to_string(s.cube_size) + " must be a power of two in 8..2048");
+    IblResources r;
+    r.full_mips = uint32_t(std::log2(double(s.cube_size))) + 1;
+    uint32_t mips = std::min(s.mips, r.full_mips);
+    if (mips < 1) throw UsageError("option 'mips' must be at least 1");
+
+    // Upload the equirect (RGB float → RGBA32F).
+    const cv::Mat& eq = env.equirect;
+    const uint32_t ew = uint32_t(eq.cols), eh = uint32_t(eq.rows);
+    vk::Buffer staging = ctx.create_buffer(VkDeviceSize(ew) * eh * 16, VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+    float* dst = staging.as<float>();
+    for (uint32_t y = 0; y < eh; ++y) {
+        const float* row = eq.ptr<float>(int(y));
+        for (uint32_t x = 0; x < ew; ++x) {
+            std::memcpy(dst + 4 * (size_t(y) * ew + x), row + 3 * x, 12);
+            dst[4 * (size_t(y) * ew + x) + 3] = 1.0f;
+        }
+    }
+    vk::Image equirect = ctx.create_image(VK_FORMAT_R32G32B32A32_SFLOAT, ew, eh, 1, false);
+    r.source_cube = ctx.create_image(VK_FORMAT_R32G32B32A32_SFLOAT, s.cube_size, s.cube_size, r.full_mips, true);
+
+    r.native_r11g11b10 = s.storage == "r11g11b10" &&
+                         ctx.format_supports(VK_FORMAT_B10G11R11_UFLOAT_PACK32,
+                                             VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT | VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT);
+    VkFormat pf = storage_format(s.storage, r.native_r11g11b10);
+    if (!ctx.format_supports(pf, VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT | VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT))
+        throw EnvironmentError(ctx.info().device_name + ": storage=" + s.storage +
+                               " needs a format usable as a filtered storage image");
+    r.prefiltered = s.prefiltered ? ctx.create_image(pf, s.cube_size, s.cube_size, mips, true)
+                                  : ctx.create_image(VK_FORMAT_R16G16B16A16_SFLOAT, 1, 1, 1, true);
+    r.sh = ctx.create_buffer(10 * 16);
+    r.lut = s.lut ? ctx.create_image(VK_FORMAT_R16G16_SFLOAT, s.lut_size, s.lut_size, 1, false)
+                  : ctx.create_image(VK_FORMAT_R16G16_SFLOAT, 1, 1, 1, false);
+    r.irradiance = s.irradiance_cube
+                       ? ctx.create_image(VK_FORMAT_R32G32B32A32_SFLOAT, s.irradiance_size, s.irradiance_size, 1, true)
+                       : ctx.create_image(VK_FORMAT_R32G32B32A32_SFLOAT, 1, 1, 1, true);
+
+    const auto& p_e2c = gpu.pipeline("equirect_to_cube.comp", {}, {kSampled, kStorageImage}, 12);
+    const auto& p_down = gpu.pipeline("downsample_cube.comp", {}, {kStorageImage, kStorageImage}, 4);
+    vk::Defines pdefs = storage_defines(s, r.native_r11g11b10);
+    pdefs["MIP_MAPPING"] = mip_mapping_define(s.mip_mapping);
+    const auto& p_pre = gpu.pipeline("prefilter_ggx.comp", pdefs, {kSampled, kStorageImage}, 28);
+    const auto& p_sh = gpu.pipeline("sh9_project.comp", {}, {kStorageImage, kStorageBuffer}, 4);
+
+    vk::GpuTimer timer(ctx, 8);
+    ctx.submit([&](VkCommandBuffer cmd) {
+        timer.reset(cmd);
+        ctx.transition(cmd, equirect, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
+        ctx.copy_buffer_to_image(cmd, staging, equirect);
+        ctx.transition(cmd, equirect, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL);
+        for (vk::Image* img : {&r.source_cube, &r.prefiltered, &r.lut, &r.irradiance})
+            ctx.transition(cmd, *img, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL);
+
+        // 1. equirect → cube, supersampled so each cube texel averages the equirect pixels it covers.
+        timer.begin(cmd, "equirect_to_cube");
+        struct { uint32_t size, ss; float rot; } pe{s.cube_size, std::max(1u, (ew + 4 * s.cube_size - 1) / (4 * s.cube_size)),
+                                                    s.env_rotation_deg};
+        p_e2c.dispatch(cmd, {vk::Binding::sampled_image(0, equirect.sampled_view, ctx.equirect_sampler()),
+                             vk::Binding::storage_image(1, r.source_cube.storage_views[0])},
+                       &pe, sizeof pe, groups(s.cube_size), groups(s.cube_size), 6);
+        timer.end(cmd);
+        ctx.barrier(cmd);
+
+        timer.begin(cmd, "downsample_cube");
+        for (uint32_t m = 1; m < r.full_mips; ++m) {
+            uint32_t size = std::max(1u, s.cube_size >> m);
+            p_down.dispatch(cmd, {vk::Binding::storage_image(0, r.source_cube.storage_views[m - 1]),
+                                  vk::Binding::storage_image(1, r.source_cube.storage_views[m])},
+                            &size, 4, groups(size), groups(size), 6);
+            ctx.barrier(cmd);
+        }
+        timer.end(cmd);
+
+        if (s.prefiltered) {
+            timer.begin(cmd, "prefilter_ggx");
+            for (uint32_t m = 0; m < mips; ++m) {
+                struct { uint32_t mip, dst_size, src_size, samples; float full_mips, max_lod, src_max_lod; } pp{
+                    m, std::max(1u, s.cube_size >> m), s.cube_size, s.prefilter_samples, float(r.full_mips),
+                    float(mips - 1), float(r.full_mips - 1)};
+                p_pre.dispatch(cmd, {vk::Binding::sampled_image(0, r.source_cube.sampled_view, ctx.linear_sampler()),
+                                     vk::Binding::storage_image(1, r.prefiltered.storage_views[m])},
+                               &pp, sizeof pp, groups(pp.dst_size), groups(pp.dst_size), 6);
+            }
+            timer.end(cmd);
+            ctx.barrier(cmd);
+        }
+
+        // SH9 from a 32² level (or the base if smaller): enough for 9 coefficients, and exact weights.
+        uint32_t sh_mip = s.cube_size > 32 ? uint32_t(std::log2(double(s.cube_size / 32))) : 0;
+        uint32_t sh_size = s.cube_size >> sh_mip;
+        timer.begin(cmd, "sh9_project");
+        p_sh.dispatch(cmd, {vk::Binding::storage_image(0, r.source_cube.storage_views[sh_mip]),
+                            vk::Binding::storage_buffer(1, r.sh)},
+                      &sh_size, 4, 1);
+        timer.end(cmd);
+
+        if (s.lut) {
+            const auto& p_lut = gpu.pipeline("dfg_lut.comp", {}, {kStorageImage}, 8);
+            timer.begin(cmd, "dfg_lut");
+            uint32_t pl[2] = {s.lut_size, s.lut_samples};
+            p_lut.dispatch(cmd, {vk::Binding::storage_image(0, r.lut.storage_views[0])}, pl, 8, groups(s.lut_size),
+                           groups(s.lut_size), 1);
+            timer.end(cmd);
+        }
+        if (s.irradiance_cube) {
+            const auto& p_irr = gpu.pipeline("irradiance_cube.comp", {}, {kStorageImage, kStorageImage}, 8);
+            uint32_t src_mip = s.cube_size > 16 ? uint32_t(std::log2(double(s.cube_size / 16))) : 0;
+            uint32_t pi[2] = {s.irradiance_size, s.cube_size >> src_mip};
+            timer.begin(cmd, "irradiance_cube");
+            p_irr.dispatch(cmd, {vk::Binding::storage_image(0, r.source_cube.storage_views[src_mip]),
+                                 vk::Binding::storage_image(1, r.irradiance.storage_views[0])},
+                           pi, 8, groups(s.irradiance_size), groups(s.irradiance_size), 6);
+            timer.end(cmd);
+        }
+        ctx.barrier(cmd);
+    });
+    for (auto& [name, ms] : timer.results()) timings.push_back({name, ms, true, true});
+    return r;
+}
+
+} // namespace iblcheck

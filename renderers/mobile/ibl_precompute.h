@@ -1,0 +1,48 @@
+// The environment-dependent passes of the pipeline (done once per environment on a device):
+// equirect → cube, its box pyramid, the GGX prefiltered chain, SH9, the DFG LUT and the
+// irradiance cube. The mobile method uses all of them; the sampled peer the pyramid and SH9.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "gpu_session.h"
+#include "renderers/environments/environment.h"
+#include "renderers/render_api.h"
+
+namespace iblcheck {
+
+struct PrecomputeSettings {
+    uint32_t cube_size = 128;        // base size of the cubes (64–512)
+    uint32_t mips = 7;               // levels of the prefiltered chain (the first seed's 7)
+    uint32_t prefilter_samples = 64;
+    std::string mip_mapping = "ue4"; // ue4 | filament | origin
+    std::string storage = "rgba16f"; // rgba16f | rgba32f | rgbm8 | r11g11b10
+    float rgbm_range = 6.0f;
+    bool prefiltered = true;         // build the GGX chain (the sampled method does not need it)
+    bool lut = false;                // env_brdf=lut
+    uint32_t lut_size = 64;
+    uint32_t lut_samples = 512;
+    bool irradiance_cube = false;    // diffuse=irradiance_cube
+    uint32_t irradiance_size = 32;
+    float env_rotation_deg = 0;
+};
+
+struct IblResources {
+    vk::Image source_cube;   // rgba32f, full box pyramid
+    vk::Image prefiltered;   // storage format, `mips` levels
+    vk::Buffer sh;           // 10 × vec4: SH9 of E/π, then the mean radiance
+    vk::Image lut;           // rg16f (1×1 placeholder when unused)
+    vk::Image irradiance;    // rgba32f cube (1×1 placeholder when unused)
+    uint32_t full_mips = 0;  // log2(cube_size) + 1
+    bool native_r11g11b10 = false;
+};
+
+// Records and runs the precompute passes; appends their GPU timings (precompute = true).
+IblResources run_precompute(GpuSession& gpu, const Environment& env, const PrecomputeSettings& s,
+                            std::vector<PassTiming>& timings);
+
+// Defines that select the storage format in GLSL (storage.glsl).
+vk::Defines storage_defines(const PrecomputeSettings& s, bool native_r11g11b10);
+std::string mip_mapping_define(const std::string& name);
+
+} // namespace iblcheck

@@ -1,0 +1,11 @@
+// The system under test: the mobile split-sum IBL pipeline on Vulkan (issue 4).
+#pragma once
+#include "gpu_session.h"
+#include "renderers/environments/environment.h"
+#include "renderers/render_api.h"
+
+namespace iblcheck {
+RenderResult render_mobile(GpuSession& gpu, const Environment& env, const TestSpec& spec);
+// The importance-sampled peer (Substance Painter's approach, third seed): renderers/sampled/.
+RenderResult render_sampled(GpuSession& gpu, const Environment& env, const TestSpec& spec);
+}

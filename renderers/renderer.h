@@ -1,0 +1,53 @@
+// The front door of renderers/: render(TestSpec) for any method, the catalogue of methods and
+// options (`iblcheck list`), and option validation (unknown keys and values exit 2).
+#pragma once
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "render_api.h"
+#include "renderers/vulkan/context.h"
+
+namespace iblcheck {
+
+class GpuSession;
+struct Environment;
+
+struct MethodInfo {
+    std::string name;
+    std::string description;
+};
+std::vector<MethodInfo> method_catalog();
+
+struct OptionInfo {
+    std::string key;
+    std::string default_value;
+    std::string values;      // "ue4|filament|origin" or a range/description
+    std::string methods;     // "mobile", "mobile,sampled", "all"
+    std::string description;
+};
+std::vector<OptionInfo> option_catalog();
+
+// Throws UsageError for an unknown method, or an option key that `method` does not read.
+void validate_spec(const TestSpec& spec);
+
+class Renderer {
+  public:
+    explicit Renderer(vk::ContextOptions options = {});
+    ~Renderer();
+    RenderResult render(const TestSpec& spec);
+    // The GPU session (created on first use); throws EnvironmentError without a driver.
+    GpuSession& gpu();
+    const Environment& environment(const std::string& spec);
+    // Driver description for provenance: {"device":…, "driver":…, "mesa":…, "llvm":…}; empty
+    // until the GPU was used.
+    nlohmann::json driver_json();
+
+  private:
+    vk::ContextOptions options_;
+    std::unique_ptr<GpuSession> gpu_;
+    std::map<std::string, std::unique_ptr<Environment>> environments_;
+};
+
+} // namespace iblcheck

@@ -1,0 +1,23 @@
+// The split sum's second factor (option env_brdf). ENV_BRDF: 0 approx, 1 lut.
+#ifndef IBLCHECK_ENV_BRDF_GLSL
+#define IBLCHECK_ENV_BRDF_GLSL
+#include "precision.glsl"
+#ifndef ENV_BRDF
+#define ENV_BRDF 0
+#endif
+
+// EnvBRDFApprox: Karis 2014, "Physically Based Shading on Mobile" (after Lazarov 2013, "Getting
+// More Physical in Call of Duty: Black Ops II"). An analytic fit of (A, B); the constants are the
+// published ones and are the knob the gate test perturbs (ENV_BRDF_APPROX_C0/C1).
+#ifndef ENV_BRDF_APPROX_C0
+#define ENV_BRDF_APPROX_C0 vec4(-1.0, -0.0275, -0.572, 0.022)
+#endif
+#ifndef ENV_BRDF_APPROX_C1
+#define ENV_BRDF_APPROX_C1 vec4(1.0, 0.0425, 1.04, -0.04)
+#endif
+hvec2 env_brdf_approx(hfloat roughness, hfloat n_dot_v) {
+    hvec4 r = hfloat(roughness) * hvec4(ENV_BRDF_APPROX_C0) + hvec4(ENV_BRDF_APPROX_C1);
+    hfloat a004 = min(r.x * r.x, hfloat(exp2(-9.28 * float(n_dot_v)))) * r.x + r.y;
+    return hvec2(-1.04, 1.04) * a004 + r.zw;
+}
+#endif

@@ -1,0 +1,28 @@
+// UE4's mobile reflection normalisation (option normalization; second seed, and UE4's
+// ReflectionEnvironmentShared.ush ComputeMixingWeight). NORMALIZATION: 0 off, 1 ue4.
+//   MixingAlpha  = smoothstep(0, 1, saturate((r − begin) / (end − begin)))
+//   MixingWeight = min(indirect_irradiance / max(average_brightness, 1e-4), largest_weight)
+//   scale        = lerp(1, MixingWeight, MixingAlpha)
+// average_brightness is the rgb mean (not luminance: UE4's choice, see the seed) of the 1×1 mip,
+// i.e. the mean radiance of the environment. indirect_irradiance is what a lightmap or the
+// indirect-lighting cache would give: by default the rgb mean of the SH9 diffuse lighting E(n)/π,
+// or a constant (option indirect_irradiance).
+#ifndef IBLCHECK_MOBILE_NORMALIZATION_GLSL
+#define IBLCHECK_MOBILE_NORMALIZATION_GLSL
+#include "precision.glsl"
+#ifndef NORMALIZATION
+#define NORMALIZATION 0
+#endif
+
+hfloat reflection_mixing_scale(hfloat roughness, hfloat indirect_irradiance, hfloat average_brightness,
+                               hfloat begin_roughness, hfloat end_roughness, hfloat largest_weight) {
+#if NORMALIZATION == 1
+    hfloat alpha = smoothstep(hfloat(0.0), hfloat(1.0),
+                              clamp((roughness - begin_roughness) / (end_roughness - begin_roughness), hfloat(0.0), hfloat(1.0)));
+    hfloat weight = min(indirect_irradiance / max(average_brightness, hfloat(1e-4)), largest_weight);
+    return mix(hfloat(1.0), weight, alpha);
+#else
+    return hfloat(1.0);
+#endif
+}
+#endif

@@ -1,0 +1,56 @@
+#version 460
+// Pass 2: GGX prefiltered specular mip chain (the split sum's first factor, Karis 2013 eq. 3 with
+// n = v = r), with filtered importance sampling (Křivánek & Colbert 2008, GPU Gems 3 ch. 20):
+// each sample reads the source pyramid at the lod whose texel solid angle matches the sample's,
+//   lod = 0.5·log2(Ωs / Ωp) + 1,  Ωs = 1 / (N · pdf),  Ωp = 4π / (6 · base²),  pdf = D(h) / 4 at n = v.
+// Hammersley points are rotated per texel (random_rotation), which trades banding for noise.
+// Mip 0 is an exact copy of the source (a mirror); mip m ≥ 1 uses roughness lod_to_roughness(m).
+#include "common.glsl"
+#include "brdf.glsl"
+#include "mip_mapping.glsl"
+#include "storage.glsl"
+
+layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;
+layout(binding = 0) uniform samplerCube source;   // rgba32f, box-filtered pyramid
+layout(binding = 1, STORAGE_FORMAT) uniform writeonly image2DArray dst;
+layout(push_constant) uniform Push {
+    uint mip;
+    uint dst_size;
+    uint source_size;
+    uint sample_count;
+    float full_mips;
+    float max_lod;
+    float source_max_lod;
+} pc;
+
+void main() {
+    uvec3 t = gl_GlobalInvocationID;
+    if (t.x >= pc.dst_size || t.y >= pc.dst_size) return;
+    vec3 n = cube_texel_direction(t, pc.dst_size);
+    vec3 result;
+    if (pc.mip == 0u) {
+        result = textureLod(source, n, 0.0).rgb;
+    } else {
+        float r = lod_to_roughness(float(pc.mip), pc.full_mips, pc.max_lod);
+        float alpha = max(r * r, 1e-4);
+        float omega_p = 4.0 * PI / (6.0 * float(pc.source_size * pc.source_size));
+        vec2 rot = random_rotation(uvec3(t.xy, t.z + 6u * pc.mip));
+        vec3 sum = vec3(0.0);
+        float weight = 0.0;
+        for (uint i = 0u; i < pc.sample_count; ++i) {
+            vec2 xi = fract(hammersley(i, pc.sample_count) + rot);
+            vec3 h = importance_sample_ggx(xi, alpha, n);
+            vec3 l = normalize(2.0 * dot(n, h) * h - n);
+            float n_dot_l = dot(n, l);
+            if (n_dot_l <= 0.0) continue;
+            float n_dot_h = max(dot(n, h), 0.0);
+            float pdf = d_ggx(n_dot_h, alpha) * 0.25;
+            float omega_s = 1.0 / (float(pc.sample_count) * pdf + 1e-8);
+            float lod = clamp(0.5 * log2(omega_s / omega_p) + 1.0, 0.0, pc.source_max_lod);
+            sum += textureLod(source, l, lod).rgb * n_dot_l;
+            weight += n_dot_l;
+        }
+        result = sum / max(weight, 1e-8);
+    }
+    imageStore(dst, ivec3(t), encode_storage(result));
+}

@@ -1,0 +1,59 @@
+// Analytic scene: camera rays and sphere intersection, mirroring renderers/scenes/scene.h
+// (the same convention on the CPU side, so all three methods see the same geometry).
+#ifndef IBLCHECK_SCENE_GLSL
+#define IBLCHECK_SCENE_GLSL
+
+struct SphereGpu {
+    vec4 center_radius;
+    vec4 base_color_metallic;
+    vec4 roughness_bump;   // roughness, bump amplitude, bump frequency, bump phase
+};
+
+layout(binding = 0, std430) readonly buffer SceneBuffer {
+    vec4 eye_ortho;       // xyz eye, w: 1 orthographic, 0 perspective
+    vec4 forward_half_h;  // xyz forward, w: orthographic half height
+    vec4 right_tan_half;  // xyz right, w: tan(fov_y / 2)
+    vec4 up_pad;          // xyz up
+    uvec4 counts;         // x: sphere count
+    SphereGpu spheres[];
+} scene;
+
+// scene.h: ndc = (2·px/W − 1, 1 − 2·py/H); orthographic: parallel rays from the image plane,
+// perspective: from the eye.
+void camera_ray(vec2 p, vec2 size, out vec3 origin, out vec3 dir) {
+    vec2 ndc = vec2(2.0 * p.x / size.x - 1.0, 1.0 - 2.0 * p.y / size.y);
+    float aspect = size.x / size.y;
+    vec3 f = scene.forward_half_h.xyz, r = scene.right_tan_half.xyz, u = scene.up_pad.xyz;
+    if (scene.eye_ortho.w > 0.5) {
+        float hh = scene.forward_half_h.w;
+        origin = scene.eye_ortho.xyz + r * (ndc.x * hh * aspect) + u * (ndc.y * hh);
+        dir = f;
+    } else {
+        float th = scene.right_tan_half.w;
+        origin = scene.eye_ortho.xyz;
+        dir = normalize(f + r * (ndc.x * th * aspect) + u * (ndc.y * th));
+    }
+}
+
+// Nearest hit in front of the origin; returns the sphere index or −1.
+int intersect_scene(vec3 o, vec3 d, out float t_hit) {
+    int best = -1;
+    t_hit = 1e30;
+    for (uint i = 0u; i < scene.counts.x; ++i) {
+        vec3 c = scene.spheres[i].center_radius.xyz;
+        float rad = scene.spheres[i].center_radius.w;
+        vec3 oc = o - c;
+        float b = dot(oc, d);
+        float q = dot(oc, oc) - rad * rad;
+        float disc = b * b - q;
+        if (disc < 0.0) continue;
+        float t = -b - sqrt(disc);
+        if (t > 0.0 && t < t_hit) {
+            t_hit = t;
+            best = int(i);
+        }
+    }
+    return best;
+}
+
+#endif

@@ -1,0 +1,208 @@
+#include "shader_compiler.h"
+
+#include <glslang/Public/ResourceLimits.h>
+#include <glslang/Public/ShaderLang.h>
+#include <glslang/SPIRV/GlslangToSpv.h>
+
+#include <algorithm>
+#include <fstream>
+#include <memory>
+#include <mutex>
+#include <regex>
+#include <set>
+#include <sstream>
+
+#include "harness/common/errors.h"
+#include "harness/common/hash.h"
+
+namespace fs = std::filesystem;
+
+namespace iblcheck::vk {
+
+namespace {
+
+std::string read_text(const fs::path& p) {
+    std::ifstream f(p, std::ios::binary);
+    if (!f) throw ShaderCompileError(p.string() + ": cannot open shader source");
+    std::stringstream ss;
+    ss << f.rdbuf();
+    return ss.str();
+}
+
+fs::path resolve_include(const std::string& name, const fs::path& includer_dir) {
+    fs::path a = includer_dir / name;
+    if (fs::exists(a)) return fs::weakly_canonical(a);
+    fs::path b = shader_dir() / name;
+    if (fs::exists(b)) return fs::weakly_canonical(b);
+    return {};
+}
+
+// Hashes the file and, recursively, every file it includes (in order), so the cache key changes
+// whenever any of them does. Missing includes are left for glslang to report with file:line.
+void hash_sources(const fs::path& file, Fnv1a64& h, std::set<fs::path>& seen) {
+    if (!seen.insert(file).second) return;
+    std::string text = read_text(file);
+    h.update(file.filename().string());
+    h.update(text);
+    static const std::regex inc(R"re(^\s*#\s*include\s*"([^"]+)")re");
+    std::istringstream in(text);
+    std::string line;
+    while (std::getline(in, line)) {
+        std::smatch m;
+        if (std::regex_search(line, m, inc)) {
+            fs::path p = resolve_include(m[1].str(), file.parent_path());
+            if (!p.empty()) hash_sources(p, h, seen);
+        }
+    }
+}
+
+class FileIncluder : public glslang::TShader::Includer {
+  public:
+    IncludeResult* includeLocal(const char* header, const char* includer, size_t) override {
+        fs::path dir = fs::path(includer).parent_path();
+        fs::path p = resolve_include(header, dir.empty() ? shader_dir() : dir);
+        if (p.empty()) return nullptr;
+        auto* text = new std::string(read_text(p));
+        return new IncludeResult(p.string(), text->data(), text->size(), text);
+    }
+    IncludeResult* includeSystem(const char* header, const char* includer, size_t depth) override {
+        return includeLocal(header, includer, depth);
+    }
+    void releaseInclude(IncludeResult* r) override {
+        if (!r) return;
+        delete static_cast<std::string*>(r->userData);
+        delete r;
+    }
+};
+
+// glslang reports "ERROR: /path/file.comp:12: 'x' : undeclared identifier"; reformat each to
+// "file:line: message" so editors and CI logs link to it.
+std::string format_log(const std::string& log) {
+    static const std::regex err(R"re((ERROR|WARNING): ([^:\n]+):(\d+): (.*))re");
+    std::istringstream in(log);
+    std::string line, out;
+    while (std::getline(in, line)) {
+        std::smatch m;
+        if (std::regex_search(line, m, err)) {
+            if (m[1] == "WARNING") continue;
+            out += m[2].str() + ":" + m[3].str() + ": " + m[4].str() + "\n";
+        } else if (line.find("ERROR:") != std::string::npos &&
+                   line.find("compilation errors") == std::string::npos) {
+            out += line + "\n";
+        }
+    }
+    return out.empty() ? log : out;
+}
+
+struct GlslangProcess {
+    GlslangProcess() { glslang::InitializeProcess(); }
+    ~GlslangProcess() { glslang::FinalizeProcess(); }
+};
+
+std::mutex& compile_mutex() {
+    static std::mutex m;
+    return m;
+}
+
+} // namespace
+
+fs::path shader_dir() {
+    if (const char* env = std::getenv("IBLCHECK_SHADER_DIR"); env && *env) return fs::path(env);
+    return fs::path(IBLCHECK_SOURCE_DIR) / "renderers" / "shaders";
+}
+
+fs::path spirv_cache_dir() {
+    if (const char* env = std::getenv("IBLCHECK_CACHE_DIR"); env && *env) return fs::path(env) / "spirv";
+    return fs::path(IBLCHECK_SOURCE_DIR) / ".cache" / "spirv";
+}
+
+std::string shader_tree_hash() {
+    std::vector<fs::path> files;
+    fs::path dir = shader_dir();
+    if (!fs::is_directory(dir)) throw EnvironmentError(dir.string() + ": shader folder not found");
+    for (const auto& e : fs::recursive_directory_iterator(dir))
+        if (e.is_regular_file()) files.push_back(e.path());
+    std::sort(files.begin(), files.end());
+    Fnv1a64 h;
+    for (const auto& f : files) {
+        h.update(fs::relative(f, dir).string());
+        h.update(read_text(f));
+    }
+    return h.hex();
+}
+
+CompiledShader compile_compute_shader(const std::string& name, const Defines& defines) {
+    fs::path p = shader_dir() / name;
+    if (!fs::exists(p)) throw ShaderCompileError(p.string() + ": shader source not found");
+    return compile_compute_shader_file(p, defines);
+}
+
+CompiledShader compile_compute_shader_file(const fs::path& path_in, const Defines& defines) {
+    fs::path path = fs::weakly_canonical(path_in);
+    Fnv1a64 h;
+    h.update("comp;glslang-vulkan1.2;");
+    std::set<fs::path> seen;
+    hash_sources(path, h, seen);
+    std::string preamble = "#extension GL_GOOGLE_include_directive : require\n";
+    for (const auto& [k, v] : defines) {
+        preamble += "#define " + k + " " + v + "\n";
+        h.update(k + "=" + v + ";");
+    }
+    CompiledShader out;
+    out.source_hash = h.hex();
+
+    fs::path cached = spirv_cache_dir() / (out.source_hash + ".spv");
+    if (std::ifstream f{cached, std::ios::binary}) {
+        std::vector<char> bytes((std::istreambuf_iterator<char>(f)), {});
+        if (bytes.size() >= 20 && bytes.size() % 4 == 0) {
+            out.spirv.resize(bytes.size() / 4);
+            std::memcpy(out.spirv.data(), bytes.data(), bytes.size());
+            if (out.spirv[0] == 0x07230203u) {
+                out.from_cache = true;
+                return out;
+            }
+        }
+    }
+
+    std::string source = read_text(path);
+    {
+        std::lock_guard lock(compile_mutex());
+        static GlslangProcess process;
+        glslang::TShader shader(EShLangCompute);
+        const char* src = source.c_str();
+        std::string name = path.string();
+        const char* names = name.c_str();
+        shader.setStringsWithLengthsAndNames(&src, nullptr, &names, 1);
+        shader.setPreamble(preamble.c_str());
+        shader.setEntryPoint("main");
+        shader.setEnvInput(glslang::EShSourceGlsl, EShLangCompute, glslang::EShClientVulkan, 100);
+        shader.setEnvClient(glslang::EShClientVulkan, glslang::EShTargetVulkan_1_2);
+        shader.setEnvTarget(glslang::EShTargetSpv, glslang::EShTargetSpv_1_5);
+        FileIncluder includer;
+        auto msgs = static_cast<EShMessages>(EShMsgSpvRules | EShMsgVulkanRules);
+        if (!shader.parse(GetDefaultResources(), 460, false, msgs, includer))
+            throw ShaderCompileError(format_log(shader.getInfoLog()));
+        glslang::TProgram program;
+        program.addShader(&shader);
+        if (!program.link(msgs)) throw ShaderCompileError(name + ": link: " + format_log(program.getInfoLog()));
+        glslang::SpvOptions opt;
+        opt.disableOptimizer = true;  // lavapipe's LLVM optimises; keep SPIR-V faithful to the source
+        glslang::GlslangToSpv(*program.getIntermediate(EShLangCompute), out.spirv, &opt);
+    }
+
+    std::error_code ec;
+    fs::create_directories(spirv_cache_dir(), ec);
+    if (!ec) {
+        // Write-then-rename so a concurrent reader never sees a half-written file.
+        fs::path tmp = cached;
+        tmp += ".tmp" + std::to_string(::getpid());
+        if (std::ofstream f{tmp, std::ios::binary}) {
+            f.write(reinterpret_cast<const char*>(out.spirv.data()), out.spirv.size() * 4);
+            f.close();
+            fs::rename(tmp, cached, ec);
+        }
+    }
+    return out;
+}
+
+} // namespace iblcheck::vk

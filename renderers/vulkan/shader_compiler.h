@@ -1,0 +1,42 @@
+// Run-time GLSL → SPIR-V compilation with glslang, so a shader edit needs no rebuild.
+//
+// Sources live under renderers/shaders/ (IBLCHECK_SHADER_DIR overrides the folder, which is how
+// `iblcheck bisect` and the gate test point at a modified copy). `#include "x.glsl"` resolves
+// relative to the including file, then to the shader folder. Variants are preprocessor defines
+// (named as the options are: DOMINANT_DIR, MIP_MAPPING, ...) or specialization constants set at
+// pipeline creation. Compiled SPIR-V is cached on disk, keyed by a hash of the source text of
+// the file and everything it includes, plus the defines and the stage.
+#pragma once
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace iblcheck::vk {
+
+using Defines = std::map<std::string, std::string>;
+
+struct CompiledShader {
+    std::vector<uint32_t> spirv;
+    std::string source_hash; // hash of the sources + defines: the key of the cache, for provenance
+    bool from_cache = false;
+};
+
+// The folder shaders are read from: $IBLCHECK_SHADER_DIR or <source root>/renderers/shaders.
+std::filesystem::path shader_dir();
+
+// Compiles the compute shader `name` (a file under shader_dir(), e.g. "prefilter_ggx.comp").
+// Throws ShaderCompileError whose message starts "file:line: " for every error glslang reports.
+CompiledShader compile_compute_shader(const std::string& name, const Defines& defines = {});
+
+// Same, for a full path (tests compile shaders from temporary folders).
+CompiledShader compile_compute_shader_file(const std::filesystem::path& path, const Defines& defines = {});
+
+// A hash over every .glsl/.comp file in shader_dir(): the "shader source hash" of provenance.
+std::string shader_tree_hash();
+
+// Where cached SPIR-V goes: $IBLCHECK_CACHE_DIR/spirv or <source root>/.cache/spirv.
+std::filesystem::path spirv_cache_dir();
+
+} // namespace iblcheck::vk

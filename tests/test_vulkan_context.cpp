@@ -1,0 +1,185 @@
+// The Vulkan plumbing on lavapipe: a compute shader checked value by value (with validation on and
+// no validation error allowed), fp16 arithmetic as the driver does it, the run-time compiler's
+// include/define/cache behaviour and its error path, and `iblcheck doctor` without a driver.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sys/wait.h>
+
+#include "harness/common/errors.h"
+#include "renderers/vulkan/context.h"
+
+namespace fs = std::filesystem;
+using namespace iblcheck;
+
+namespace {
+
+fs::path temp_dir(const std::string& name) {
+    fs::path p = fs::temp_directory_path() / ("iblcheck_test_" + name + "_" + std::to_string(::getpid()));
+    fs::create_directories(p);
+    return p;
+}
+
+void write_file(const fs::path& p, const std::string& text) {
+    std::ofstream f(p);
+    f << text;
+}
+
+// Runs a shell command, returns its exit status and output (stdout + stderr).
+int run_command(const std::string& cmd, std::string& output) {
+    FILE* pipe = popen((cmd + " 2>&1").c_str(), "r");
+    std::array<char, 512> buf;
+    output.clear();
+    while (fgets(buf.data(), buf.size(), pipe)) output += buf.data();
+    int status = pclose(pipe);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+std::vector<float> run_shader(vk::Context& ctx, const vk::CompiledShader& shader, uint32_t n) {
+    vk::Buffer buf = ctx.create_buffer(n * 4);
+    vk::ComputePipeline p(ctx, shader, {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}, 4);
+    ctx.submit([&](VkCommandBuffer cmd) {
+        p.dispatch(cmd, {vk::Binding::storage_buffer(0, buf)}, &n, 4, (n + 63) / 64);
+        vk::Context::barrier(cmd);
+    });
+    const float* f = buf.as<float>();
+    return std::vector<float>(f, f + n);
+}
+
+} // namespace
+
+TEST(VulkanContext, PicksLavapipeAndReportsVersions) {
+    vk::Context ctx({"", true});
+    EXPECT_EQ(ctx.info().driver_name, "llvmpipe");
+    EXPECT_FALSE(ctx.info().mesa_version.empty()) << ctx.info().driver_info;
+    EXPECT_FALSE(ctx.info().llvm_version.empty()) << ctx.info().driver_info;
+    EXPECT_TRUE(ctx.info().timestamps);
+    EXPECT_TRUE(ctx.info().shader_float16);
+}
+
+TEST(VulkanContext, UnknownDeviceIsAnEnvironmentErrorListingDevices) {
+    try {
+        vk::Context ctx({"no-such-gpu-name", false});
+        FAIL() << "expected EnvironmentError";
+    } catch (const EnvironmentError& e) {
+        EXPECT_NE(std::string(e.what()).find("llvmpipe"), std::string::npos) << e.what();
+    }
+}
+
+TEST(VulkanCompute, ComputesValuesWithIncludesAndDefines) {
+    fs::path dir = temp_dir("compute");
+    write_file(dir / "square.glsl", "float square(float x) { return x * x; }\n");
+    write_file(dir / "values.comp", R"(#version 460
+#include "square.glsl"
+layout(local_size_x = 64) in;
+layout(binding = 0, std430) buffer Out { float v[]; } o;
+layout(push_constant) uniform P { uint n; } pc;
+void main() {
+    uint i = gl_GlobalInvocationID.x;
+    if (i < pc.n) o.v[i] = square(float(i)) + OFFSET;
+}
+)");
+    vk::Context ctx({"", true});
+    auto shader = vk::compile_compute_shader_file(dir / "values.comp", {{"OFFSET", "0.5"}});
+    auto v = run_shader(ctx, shader, 1000);
+    for (uint32_t i = 0; i < 1000; ++i) ASSERT_EQ(v[i], float(i) * float(i) + 0.5f) << "at " << i;
+    EXPECT_EQ(ctx.validation_errors(), 0) << (ctx.validation_messages().empty() ? "" : ctx.validation_messages()[0]);
+
+    // Same source + defines: the SPIR-V comes from the cache with the same key; another define
+    // gives another key.
+    auto again = vk::compile_compute_shader_file(dir / "values.comp", {{"OFFSET", "0.5"}});
+    EXPECT_TRUE(again.from_cache);
+    EXPECT_EQ(again.source_hash, shader.source_hash);
+    auto other = vk::compile_compute_shader_file(dir / "values.comp", {{"OFFSET", "1.5"}});
+    EXPECT_NE(other.source_hash, shader.source_hash);
+    EXPECT_EQ(run_shader(ctx, other, 4)[3], 10.5f);
+
+    // Editing an included file changes the key (no stale SPIR-V after a shader edit).
+    write_file(dir / "square.glsl", "float square(float x) { return x * x * 2.0; }\n");
+    auto edited = vk::compile_compute_shader_file(dir / "values.comp", {{"OFFSET", "0.5"}});
+    EXPECT_FALSE(edited.from_cache);
+    EXPECT_EQ(run_shader(ctx, edited, 4)[3], 18.5f);
+    fs::remove_all(dir);
+}
+
+TEST(VulkanCompute, Float16IsTrueHalfPrecisionOnThisDriver) {
+    // DEVELOPERS.md: lavapipe computes float16_t as fp16 (1 + 1e-4 = 1, 300·300 = inf): the
+    // precision=mediump variant relies on it.
+    fs::path dir = temp_dir("fp16");
+    write_file(dir / "half.comp", R"(#version 460
+#extension GL_EXT_shader_explicit_arithmetic_types_float16 : require
+layout(local_size_x = 64) in;
+layout(binding = 0, std430) buffer Out { float v[]; } o;
+layout(push_constant) uniform P { uint n; } pc;
+void main() {
+    if (gl_GlobalInvocationID.x != 0u) return;
+    float16_t one = float16_t(1.0) + float16_t(float(pc.n) * 1e-7);  // 1 + 1e-4 for n = 1000
+    float16_t big = float16_t(300.0 + float(pc.n) * 0.0);
+    o.v[0] = float(one);
+    o.v[1] = float(big * big);
+}
+)");
+    vk::Context ctx({"", true});
+    auto v = run_shader(ctx, vk::compile_compute_shader_file(dir / "half.comp"), 1000);
+    EXPECT_EQ(v[0], 1.0f);
+    EXPECT_TRUE(std::isinf(v[1])) << v[1];
+    fs::remove_all(dir);
+}
+
+TEST(ShaderCompiler, ErrorNamesFileAndLine) {
+    fs::path dir = temp_dir("bad");
+    write_file(dir / "bad.comp", "#version 460\nlayout(local_size_x = 1) in;\nvoid main() {\n  float x = undefined_thing;\n}\n");
+    try {
+        vk::compile_compute_shader_file(dir / "bad.comp");
+        FAIL() << "expected ShaderCompileError";
+    } catch (const ShaderCompileError& e) {
+        std::string msg = e.what();
+        EXPECT_NE(msg.find("bad.comp:4:"), std::string::npos) << msg;
+        EXPECT_NE(msg.find("undefined_thing"), std::string::npos) << msg;
+    }
+    fs::remove_all(dir);
+}
+
+TEST(ShaderCompiler, AllPipelineShadersCompile) {
+    // Every pass of renderers/shaders compiles in its default variant.
+    for (const char* s : {"equirect_to_cube.comp", "downsample_cube.comp", "prefilter_ggx.comp", "sh9_project.comp",
+                          "irradiance_cube.comp", "dfg_lut.comp", "shade_spheres.comp", "shade_sampled.comp"}) {
+        EXPECT_NO_THROW(vk::compile_compute_shader(s)) << s;
+    }
+}
+
+TEST(Doctor, NamesLlvmpipeAndExitsZero) {
+    std::string out;
+    int rc = run_command(std::string(IBLCHECK_BINARY_DIR) + "/iblcheck doctor", out);
+    EXPECT_EQ(rc, 0) << out;
+    EXPECT_NE(out.find("llvmpipe"), std::string::npos) << out;
+    EXPECT_NE(out.find("shaderFloat16:   yes"), std::string::npos) << out;
+}
+
+TEST(Doctor, WithoutDriverExitsTwoWithAFix) {
+    std::string out;
+    int rc = run_command("VK_ICD_FILENAMES=/nonexistent VK_DRIVER_FILES=/nonexistent " +
+                             std::string(IBLCHECK_BINARY_DIR) + "/iblcheck doctor",
+                         out);
+    EXPECT_EQ(rc, 2) << out;
+    EXPECT_NE(out.find("no Vulkan driver found"), std::string::npos) << out;
+    EXPECT_NE(out.find("scripts/setup.sh"), std::string::npos) << out;
+}
+
+TEST(Cli, ShaderCompileErrorExitsTwoWithFileLine) {
+    fs::path dir = temp_dir("cli_bad");
+    fs::copy(fs::path(IBLCHECK_SOURCE_DIR) / "renderers/shaders", dir / "shaders", fs::copy_options::recursive);
+    std::ofstream(dir / "shaders/env_brdf.glsl", std::ios::app) << "\nthis is not glsl;\n";
+    std::string out;
+    int rc = run_command("IBLCHECK_SHADER_DIR=" + (dir / "shaders").string() + " IBLCHECK_CACHE_DIR=" + dir.string() +
+                             " " + std::string(IBLCHECK_BINARY_DIR) +
+                             "/iblcheck render --scene sphere --env constant:1 --method mobile",
+                         out);
+    EXPECT_EQ(rc, 2) << out;
+    EXPECT_NE(out.find("env_brdf.glsl:"), std::string::npos) << out;
+    fs::remove_all(dir);
+}
