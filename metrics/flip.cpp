@@ -19,6 +19,7 @@
 #include "harness/common/errors.h"
 #include "metrics/flip/color_spaces.h"
 #include "metrics/flip/csf_filters.h"
+#include "metrics/flip/fast_math.h"
 #include "metrics/flip/feature_detection.h"
 #include "metrics/flip/magma_table.h"
 #include "metrics/flip/parallel.h"
@@ -58,6 +59,119 @@ const SrgbLut& srgb_lut() {
 
 inline float clamp01(float v) { return std::min(std::max(v, 0.0f), 1.0f); }
 
+// Hot kernels, compiled for AVX2 and for baseline x86-64 and picked at load time. The results are
+// identical either way: no FMA contraction (-ffp-contract=off), only correctly rounded IEEE
+// operations, same order per element.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define IBLCHECK_SIMD_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define IBLCHECK_SIMD_CLONES
+#endif
+
+// acc[x] = sum_k taps[k] * src[k][x], k ascending (the tool's tap order). For the horizontal
+// pass src[k] = row + k; for the vertical pass src[k] is the clamped row y + k - r.
+// Register-blocked over 16 / 8 pixels (GCC vector extension; two SSE halves on the baseline
+// clone, one AVX register on the AVX2 clone) so the accumulators never round-trip through memory.
+typedef float v8f __attribute__((vector_size(32)));
+__attribute__((always_inline)) inline v8f load8(const float* p) {
+    v8f v;
+    std::memcpy(&v, p, sizeof v);
+    return v;
+}
+__attribute__((always_inline)) inline void store8(float* p, v8f v) { std::memcpy(p, &v, sizeof v); }
+
+IBLCHECK_SIMD_CLONES
+void fir_accumulate(const float* const* src, const float* taps, int ntaps, int n, float* __restrict acc) {
+    int x = 0;
+    for (; x + 16 <= n; x += 16) {
+        const v8f t0 = v8f{} + taps[0];
+        v8f a = v8f{} + t0 * load8(src[0] + x);
+        v8f b = v8f{} + t0 * load8(src[0] + x + 8);
+        for (int k = 1; k < ntaps; ++k) {
+            const v8f t = v8f{} + taps[k];
+            a += t * load8(src[k] + x);
+            b += t * load8(src[k] + x + 8);
+        }
+        store8(acc + x, a);
+        store8(acc + x + 8, b);
+    }
+    for (; x + 8 <= n; x += 8) {
+        v8f a = v8f{} + (v8f{} + taps[0]) * load8(src[0] + x);
+        for (int k = 1; k < ntaps; ++k) a += (v8f{} + taps[k]) * load8(src[k] + x);
+        store8(acc + x, a);
+    }
+    for (; x < n; ++x) {
+        float a = 0.0f + taps[0] * src[0][x];
+        for (int k = 1; k < ntaps; ++k) a += taps[k] * src[k][x];
+        acc[x] = a;
+    }
+}
+
+// Linear RGB row -> YCxCz (padded output, offset by `pad`) and normalised Y for features.
+IBLCHECK_SIMD_CLONES
+void rgb_row_to_ycxcz(const float* __restrict R, const float* __restrict G, const float* __restrict B,
+                      int n, float* __restrict Y, float* __restrict Cx, float* __restrict Cz) {
+    for (int x = 0; x < n; ++x) {
+        float X, Yy, Z;
+        linear_rgb_to_xyz(R[x], G[x], B[x], X, Yy, Z);
+        xyz_to_ycxcz(X, Yy, Z, Y[x], Cx[x], Cz[x]);
+    }
+}
+
+inline float lab_f_fast(float t) {
+    constexpr float delta = 6.0f / 29.0f;
+    constexpr float delta_cube = delta * delta * delta;
+    constexpr float factor = 1.0f / (3.0f * delta * delta);
+    constexpr float term = 4.0f / 29.0f;
+    const float c = fast_cbrt(t > delta_cube ? t : delta_cube);
+    return t > delta_cube ? c : factor * t + term;
+}
+
+// Filtered YCxCz may leave the gamut: clamp in linear RGB, then CIELab with Hunt (Eq. 4).
+inline void to_hunt_lab(float Y, float Cx, float Cz, float& L, float& a, float& b) {
+    float X, Yy, Z, r, g, bl;
+    ycxcz_to_xyz(Y, Cx, Cz, X, Yy, Z);
+    xyz_to_linear_rgb(X, Yy, Z, r, g, bl);
+    r = std::min(std::max(r, 0.0f), 1.0f);
+    g = std::min(std::max(g, 0.0f), 1.0f);
+    bl = std::min(std::max(bl, 0.0f), 1.0f);
+    linear_rgb_to_xyz(r, g, bl, X, Yy, Z);
+    const float fx = lab_f_fast(X * kInvD65[0]);
+    const float fy = lab_f_fast(Yy * kInvD65[1]);
+    const float fz = lab_f_fast(Z * kInvD65[2]);
+    L = 116.0f * fy - 16.0f;
+    a = hunt(L, 500.0f * (fx - fy));
+    b = hunt(L, 200.0f * (fy - fz));
+}
+
+// Per-pixel FLIP from the vertically filtered planes. q[img * 8 + i], i: Y, Cx, Cz1, Cz2, dx,
+// ddx, dy, ddy.
+// (Baseline SSE only: GCC 12 vectorises this loop for SSE but not in an AVX2 clone.)
+void flip_pixels(const float* const* q, int n, float cmax, float pccmax, float* __restrict out) {
+    const float norm = 1.0f / std::sqrt(2.0f);
+#pragma GCC ivdep
+    for (int x = 0; x < n; ++x) {
+        // Colour difference (FLIP paper, Eqs. 4-7).
+        float Lr, ar, br, Lt, at, bt;
+        to_hunt_lab(q[0][x], q[1][x], q[2][x] + q[3][x], Lr, ar, br);
+        to_hunt_lab(q[8][x], q[9][x], q[10][x] + q[11][x], Lt, at, bt);
+        const float da = ar - at, db = br - bt;
+        const float dist = std::fabs(Lr - Lt) + std::sqrt(da * da + db * db);
+        const float c = fast_pow(dist, kQc);
+        // Eq. 7: [0, pc*cmax] -> [0, pt], [pc*cmax, cmax] -> [pt, 1].
+        const float cdiff = c < pccmax ? c * (kPt / pccmax)
+                                       : kPt + ((c - pccmax) / (cmax - pccmax)) * (1.0f - kPt);
+        // Feature difference (FLIP paper, Eq. 9).
+        const float dxr = q[4][x], ddxr = q[5][x], dyr = q[6][x], ddyr = q[7][x];
+        const float dxt = q[12][x], ddxt = q[13][x], dyt = q[14][x], ddyt = q[15][x];
+        const float edge = std::fabs(std::sqrt(dxr * dxr + dyr * dyr) - std::sqrt(dxt * dxt + dyt * dyt));
+        const float point = std::fabs(std::sqrt(ddxr * ddxr + ddyr * ddyr) - std::sqrt(ddxt * ddxt + ddyt * ddyt));
+        const float fdiff = std::sqrt(norm * (edge > point ? edge : point)); // ^qf, qf = 0.5
+        // Eq. 10: features sharpen the colour error towards 1.
+        out[x] = fast_pow(cdiff, 1.0f - fdiff);
+    }
+}
+
 class FlipEngine {
   public:
     FlipEngine(int w, int h, float ppd, int threads)
@@ -83,15 +197,13 @@ class FlipEngine {
         const int pw = w_ + 2 * pad_;
         std::vector<float> R(w_), G(w_), B(w_);
         std::vector<float> Y(pw), Cx(pw), Cz(pw), Yn(pw);
+        std::vector<const float*> src(2 * pad_ + 1);
         for (int img = 0; img < 2; ++img) {
             auto& P = planes_[img];
             for (int y = y0; y < y1; ++y) {
                 prep(img, y, R.data(), G.data(), B.data());
-                for (int x = 0; x < w_; ++x) {
-                    float X, Yy, Z;
-                    linear_rgb_to_xyz(R[x], G[x], B[x], X, Yy, Z);
-                    xyz_to_ycxcz(X, Yy, Z, Y[pad_ + x], Cx[pad_ + x], Cz[pad_ + x]);
-                }
+                rgb_row_to_ycxcz(R.data(), G.data(), B.data(), w_, Y.data() + pad_, Cx.data() + pad_,
+                                 Cz.data() + pad_);
                 // Clamp-to-edge borders, as the tool clamps the tap coordinate.
                 for (int i = 0; i < pad_; ++i) {
                     Y[i] = Y[pad_], Cx[i] = Cx[pad_], Cz[i] = Cz[pad_];
@@ -104,112 +216,62 @@ class FlipEngine {
                 for (int i = 0; i < pw; ++i) Yn[i] = Y[i] * one_over_116 + sixteen_over_116;
 
                 const size_t row = size_t(y) * w_;
-                const int so = pad_ - sf_.radius, fo = pad_ - ff_.radius;
-                filter_row(Y.data() + so, sf_.y, P[kPY].data() + row);
-                filter_row(Cx.data() + so, sf_.cx, P[kPCx].data() + row);
-                filter_row(Cz.data() + so, sf_.cz1, P[kPCz1].data() + row);
-                filter_row(Cz.data() + so, sf_.cz2, P[kPCz2].data() + row);
-                filter_row(Yn.data() + fo, ff_.dg, P[kPDx].data() + row);
-                filter_row(Yn.data() + fo, ff_.ddg, P[kPDdx].data() + row);
-                filter_row(Yn.data() + fo, ff_.g, P[kPG].data() + row);
+                auto run = [&](const std::vector<float>& in, int radius, const std::vector<float>& taps,
+                               Plane plane) {
+                    const float* base = in.data() + (pad_ - radius);
+                    for (size_t k = 0; k < taps.size(); ++k) src[k] = base + k;
+                    fir_accumulate(src.data(), taps.data(), int(taps.size()), w_, P[plane].data() + row);
+                };
+                run(Y, sf_.radius, sf_.y, kPY);
+                run(Cx, sf_.radius, sf_.cx, kPCx);
+                run(Cz, sf_.radius, sf_.cz1, kPCz1);
+                run(Cz, sf_.radius, sf_.cz2, kPCz2);
+                run(Yn, ff_.radius, ff_.dg, kPDx);
+                run(Yn, ff_.radius, ff_.ddg, kPDdx);
+                run(Yn, ff_.radius, ff_.g, kPG);
             }
         }
     }
 
-    // out[x] = sum_k taps[k] * in[x + k], k ascending.
-    void filter_row(const float* __restrict in, const std::vector<float>& taps,
-                    float* __restrict out) const {
-        const int n = int(taps.size());
-        const float t0 = taps[0];
-        for (int x = 0; x < w_; ++x) out[x] = 0.0f + t0 * in[x];
-        for (int k = 1; k < n; ++k) {
-            const float t = taps[k];
-            const float* src = in + k;
-            for (int x = 0; x < w_; ++x) out[x] += t * src[x];
-        }
-    }
-
-    // acc[x] = sum_k taps[k] * plane[clamp(y + k - r)][x0 + x], k ascending.
-    void filter_column(const std::vector<float>& plane, const std::vector<float>& taps, int y,
-                       int x0, int n, float* __restrict acc) const {
-        const int r = int(taps.size()) / 2;
-        for (int x = 0; x < n; ++x) acc[x] = 0.0f;
-        for (int k = 0; k < int(taps.size()); ++k) {
-            const int yy = std::min(std::max(y + k - r, 0), h_ - 1);
-            const float t = taps[k];
-            const float* __restrict src = plane.data() + size_t(yy) * w_ + x0;
-            for (int x = 0; x < n; ++x) acc[x] += t * src[x];
-        }
-    }
-
     void vertical_pass(float* out, bool max_merge, int y0, int y1) const {
-        constexpr int kTile = 256;
-        // Per image: Y, Cx, Cz1, Cz2, dx, ddx, dy, ddy.
-        std::vector<float> acc(2 * 8 * kTile);
-        auto A = [&](int img, int q) { return acc.data() + (img * 8 + q) * kTile; };
-        const float norm = 1.0f / std::sqrt(2.0f);
+        constexpr int kTile = 512;
+        std::vector<float> acc(16 * kTile), err(kTile);
+        const float* q[16];
+        for (int i = 0; i < 16; ++i) q[i] = acc.data() + i * kTile;
+        std::vector<const float*> src(2 * pad_ + 1);
+        auto column = [&](const std::vector<float>& plane, const std::vector<float>& taps, int y,
+                          int x0, int n, int slot) {
+            const int r = int(taps.size()) / 2;
+            for (int k = 0; k < int(taps.size()); ++k) {
+                const int yy = std::min(std::max(y + k - r, 0), h_ - 1);
+                src[k] = plane.data() + size_t(yy) * w_ + x0;
+            }
+            fir_accumulate(src.data(), taps.data(), int(taps.size()), n, acc.data() + slot * kTile);
+        };
         for (int y = y0; y < y1; ++y) {
             for (int x0 = 0; x0 < w_; x0 += kTile) {
                 const int n = std::min(kTile, w_ - x0);
                 for (int img = 0; img < 2; ++img) {
                     const auto& P = planes_[img];
-                    filter_column(P[kPY], sf_.y, y, x0, n, A(img, 0));
-                    filter_column(P[kPCx], sf_.cx, y, x0, n, A(img, 1));
-                    filter_column(P[kPCz1], sf_.cz1, y, x0, n, A(img, 2));
-                    filter_column(P[kPCz2], sf_.cz2, y, x0, n, A(img, 3));
-                    filter_column(P[kPDx], ff_.g, y, x0, n, A(img, 4));
-                    filter_column(P[kPDdx], ff_.g, y, x0, n, A(img, 5));
-                    filter_column(P[kPG], ff_.dg, y, x0, n, A(img, 6));
-                    filter_column(P[kPG], ff_.ddg, y, x0, n, A(img, 7));
+                    const int s = img * 8;
+                    column(P[kPY], sf_.y, y, x0, n, s + 0);
+                    column(P[kPCx], sf_.cx, y, x0, n, s + 1);
+                    column(P[kPCz1], sf_.cz1, y, x0, n, s + 2);
+                    column(P[kPCz2], sf_.cz2, y, x0, n, s + 3);
+                    column(P[kPDx], ff_.g, y, x0, n, s + 4);  // d/dx: G'(x) G(y)
+                    column(P[kPDdx], ff_.g, y, x0, n, s + 5); // d2/dx2: G''(x) G(y)
+                    column(P[kPG], ff_.dg, y, x0, n, s + 6);  // d/dy: G(x) G'(y)
+                    column(P[kPG], ff_.ddg, y, x0, n, s + 7); // d2/dy2: G(x) G''(y)
                 }
+                flip_pixels(q, n, cmax_, pccmax_, err.data());
                 float* dst = out + size_t(y) * w_ + x0;
-                for (int x = 0; x < n; ++x) {
-                    const float cdiff = color_difference(
-                        A(0, 0)[x], A(0, 1)[x], A(0, 2)[x] + A(0, 3)[x],
-                        A(1, 0)[x], A(1, 1)[x], A(1, 2)[x] + A(1, 3)[x]);
-                    // Feature difference (FLIP paper, Eq. 9).
-                    const float dxr = A(0, 4)[x], ddxr = A(0, 5)[x], dyr = A(0, 6)[x], ddyr = A(0, 7)[x];
-                    const float dxt = A(1, 4)[x], ddxt = A(1, 5)[x], dyt = A(1, 6)[x], ddyt = A(1, 7)[x];
-                    const float edge_r = std::sqrt(dxr * dxr + dyr * dyr);
-                    const float edge_t = std::sqrt(dxt * dxt + dyt * dyt);
-                    const float point_r = std::sqrt(ddxr * ddxr + ddyr * ddyr);
-                    const float point_t = std::sqrt(ddxt * ddxt + ddyt * ddyt);
-                    const float fdiff = std::pow(
-                        norm * std::max(std::fabs(edge_r - edge_t), std::fabs(point_r - point_t)), kQf);
-                    // Eq. 10: features sharpen the colour error towards 1.
-                    const float e = std::pow(cdiff, 1.0f - fdiff);
-                    if (max_merge) {
-                        if (e > dst[x]) dst[x] = e;
-                    } else {
-                        dst[x] = e;
-                    }
+                if (max_merge) {
+                    for (int x = 0; x < n; ++x) dst[x] = err[x] > dst[x] ? err[x] : dst[x];
+                } else {
+                    std::memcpy(dst, err.data(), sizeof(float) * n);
                 }
             }
         }
-    }
-
-    // Colour difference of two CSF-filtered YCxCz pixels (FLIP paper, Eqs. 4-7).
-    float color_difference(float Yr, float Cxr, float Czr, float Yt, float Cxt, float Czt) const {
-        float Lr, ar, br, Lt, at, bt;
-        to_hunt_lab(Yr, Cxr, Czr, Lr, ar, br);
-        to_hunt_lab(Yt, Cxt, Czt, Lt, at, bt);
-        float c = std::pow(hyab(Lr, ar, br, Lt, at, bt), kQc);
-        // Eq. 7: [0, pc*cmax] -> [0, pt], [pc*cmax, cmax] -> [pt, 1].
-        if (c < pccmax_) c *= kPt / pccmax_;
-        else c = kPt + ((c - pccmax_) / (cmax_ - pccmax_)) * (1.0f - kPt);
-        return c;
-    }
-
-    // Filtered YCxCz may leave the gamut: clamp in linear RGB, then CIELab with Hunt (Eq. 4).
-    static void to_hunt_lab(float Y, float Cx, float Cz, float& L, float& a, float& b) {
-        float X, Yy, Z, r, g, bl;
-        ycxcz_to_xyz(Y, Cx, Cz, X, Yy, Z);
-        xyz_to_linear_rgb(X, Yy, Z, r, g, bl);
-        r = clamp01(r), g = clamp01(g), bl = clamp01(bl);
-        linear_rgb_to_xyz(r, g, bl, X, Yy, Z);
-        xyz_to_lab(X, Yy, Z, L, a, b);
-        a = hunt(L, a);
-        b = hunt(L, b);
     }
 
     int w_, h_, threads_;
