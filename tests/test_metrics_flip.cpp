@@ -10,6 +10,7 @@
 #include <random>
 #include <sstream>
 
+#include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
 #include "harness/cli/compare_command.h"
@@ -356,6 +357,31 @@ TEST_F(CompareCommand, BadMetricIsUsageError) {
     c.metric = "lpips";
     EXPECT_EQ(run(c), kExitError);
     EXPECT_NE(err_.str().find("--metric"), std::string::npos);
+}
+
+TEST_F(CompareCommand, RegisteredSubcommandParsesOptions) {
+    write_png(path("a.png"), synthetic(24, 24, 1, 0.1f));
+    write_png(path("b.png"), synthetic(24, 24, 2, 0.1f));
+    CLI::App app("iblcheck");
+    int exit_code = -1;
+    register_compare_command(app, exit_code);
+    std::vector<std::string> argv = {"compare", path("a.png"), path("b.png"), "--metric", "flip",
+                                     "--ppd", "40", "--json", "--heatmap", path("h.png")};
+    std::reverse(argv.begin(), argv.end()); // CLI11 parses a reversed vector
+    testing::internal::CaptureStdout();
+    app.parse(argv);
+    const std::string printed = testing::internal::GetCapturedStdout();
+    EXPECT_EQ(exit_code, 0);
+    const auto j = nlohmann::json::parse(printed);
+    EXPECT_NEAR(j["flip"]["ppd"].get<double>(), 40.0, 1e-6);
+    EXPECT_FALSE(j.contains("ssim"));
+    EXPECT_TRUE(fs::exists(path("h.png")));
+
+    CLI::App app2("iblcheck");
+    register_compare_command(app2, exit_code);
+    std::vector<std::string> bad = {"compare", path("a.png"), path("b.png"), "--mode", "xyz"};
+    std::reverse(bad.begin(), bad.end());
+    EXPECT_THROW(app2.parse(bad), CLI::ValidationError);
 }
 
 TEST_F(CompareCommand, IdenticalImagesPerfectScores) {
