@@ -146,7 +146,7 @@ inline void to_hunt_lab(float Y, float Cx, float Cz, float& L, float& a, float& 
 
 // Per-pixel FLIP from the vertically filtered planes. q[img * 8 + i], i: Y, Cx, Cz1, Cz2, dx,
 // ddx, dy, ddy.
-// (Baseline SSE only: GCC 12 vectorises this loop for SSE but not in an AVX2 clone.)
+IBLCHECK_SIMD_CLONES
 void flip_pixels(const float* const* q, int n, float cmax, float pccmax, float* __restrict out) {
     const float norm = 1.0f / std::sqrt(2.0f);
 #pragma GCC ivdep

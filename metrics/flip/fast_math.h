@@ -46,8 +46,10 @@ inline float fast_exp2(float y) {
 
 // x^p for x >= 0, p >= 0, with pow's conventions 0^0 = 1 and 0^p = 0 (p > 0).
 inline float fast_pow(float x, float p) {
-    const float r = fast_exp2(p * fast_log2(x > 1e-30f ? x : 1e-30f));
-    return x > 1e-30f ? r : (p == 0.0f ? 1.0f : 0.0f);
+    const float tiny = x > 1e-30f ? 0.0f : 1.0f;           // arithmetic masks keep the loop
+    const float r = fast_exp2(p * fast_log2(x + tiny));     // branch-free (vectorises under AVX2)
+    const float zero_value = p == 0.0f ? 1.0f : 0.0f;
+    return r * (1.0f - tiny) + zero_value * tiny;
 }
 
 } // namespace iblcheck::flip
