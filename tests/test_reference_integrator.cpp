@@ -176,11 +176,14 @@ TEST(EnvDistribution, PdfIntegratesToOneAndMatchesSampling) {
 
 // White furnace, metal F0 = 1: every fully covered pixel equals E(n·v, α) (averaged over the pixel).
 TEST(ReferenceIntegrator, FurnaceMetalMatchesQuadrature) {
-    TestSpec spec = spec_of("furnace", "constant:1", 512);
+    // 24 px per sphere (default 64) so that 8192 spp fits a fast test. The expected value is averaged
+    // over a 32x32 grid inside each pixel: near the silhouette n.v varies fast and a 4x4 grid alone is
+    // off by up to 0.3 %.
+    TestSpec spec = spec_of("furnace", "constant:1", 8192, 120, 24);
     ReferenceRender r = render_reference_full(spec);
     Scene s = build_scene("furnace", {});
     const int W = r.result.image.cols, H = r.result.image.rows;
-    ASSERT_EQ(W, 320);
+    ASSERT_EQ(W, 120);
     std::vector<AlbedoTable> tables;
     for (const auto& sp : s.spheres) tables.emplace_back(model::alpha_from_roughness(sp.material.roughness), 1.0);
     std::vector<double> mus;
@@ -189,7 +192,7 @@ TEST(ReferenceIntegrator, FurnaceMetalMatchesQuadrature) {
     for (int y = 0; y < H; ++y)
         for (int x = 0; x < W; ++x) {
             int sph;
-            if (!pixel_mu_grid(s, W, H, x, y, 4, mus, sph)) continue;
+            if (!pixel_mu_grid(s, W, H, x, y, 32, mus, sph)) continue;
             double expect = 0;
             for (double mu : mus) expect += s.spheres[sph].material.roughness == 0 ? 1.0 : tables[sph](mu);
             expect /= mus.size();
@@ -202,7 +205,7 @@ TEST(ReferenceIntegrator, FurnaceMetalMatchesQuadrature) {
             }
             ++checked;
         }
-    EXPECT_GT(checked, 5 * 2000);
+    EXPECT_GT(checked, 5 * 200);
     for (int i = 0; i < 5; ++i) std::printf("furnace sphere r=%.2f: worst relative error %.5f\n", 0.25 * i, worst[i]);
 }
 
@@ -210,10 +213,10 @@ TEST(ReferenceIntegrator, FurnaceMetalMatchesQuadrature) {
 // 1 + the F0 = 0.04 specular albedo (the model has no (1 − F) on the diffuse term).
 TEST(ReferenceIntegrator, FurnaceDielectricIsLambertPlusSpecular) {
     Scene s = build_scene("furnace_dielectric", {});
-    TestSpec diff = spec_of("furnace_dielectric", "constant:1", 128);
+    TestSpec diff = spec_of("furnace_dielectric", "constant:1", 4096, 120, 24);
     diff.options.set("lobes", "diffuse");
     ReferenceRender rd = render_reference_full(diff);
-    TestSpec all = spec_of("furnace_dielectric", "constant:1", 512);
+    TestSpec all = spec_of("furnace_dielectric", "constant:1", 8192, 120, 24);
     ReferenceRender ra = render_reference_full(all);
     const int W = ra.result.image.cols, H = ra.result.image.rows;
     std::vector<AlbedoTable> tables;
@@ -224,7 +227,7 @@ TEST(ReferenceIntegrator, FurnaceDielectricIsLambertPlusSpecular) {
     for (int y = 0; y < H; ++y)
         for (int x = 0; x < W; ++x) {
             int sph;
-            if (!pixel_mu_grid(s, W, H, x, y, 4, mus, sph)) continue;
+            if (!pixel_mu_grid(s, W, H, x, y, 32, mus, sph)) continue;
             double spec = 0;
             for (double mu : mus)
                 spec += s.spheres[sph].material.roughness == 0 ? model::f_schlick(model::kDielectricF0, mu)
@@ -232,12 +235,14 @@ TEST(ReferenceIntegrator, FurnaceDielectricIsLambertPlusSpecular) {
             spec /= mus.size();
             for (int c = 0; c < 3; ++c) {
                 ASSERT_NEAR(rd.result.image.at<cv::Vec3f>(y, x)[c], 1.0, 2e-3) << x << "," << y;
-                ASSERT_NEAR(ra.result.image.at<cv::Vec3f>(y, x)[c] / (1.0 + spec), 1.0, 2e-3)
+                // 0.4 %: the F0 = 0.04 lobe is sampled with p_s >= 0.1 only, so this render is noisier
+                // than the metal one at equal spp (worst pixel 0.26 % at 8192 spp, no bias).
+                ASSERT_NEAR(ra.result.image.at<cv::Vec3f>(y, x)[c] / (1.0 + spec), 1.0, 4e-3)
                     << x << "," << y << " sphere " << sph;
             }
             ++checked;
         }
-    EXPECT_GT(checked, 5 * 2000);
+    EXPECT_GT(checked, 5 * 200);
 }
 
 namespace {

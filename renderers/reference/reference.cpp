@@ -82,10 +82,13 @@ EnvDistribution::EnvDistribution(const Environment& env) {
             lum[size_t(j) * w_ + i] = 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
         }
     prob_.assign(size_t(w_) * h_, 0.0);
+    row_dcos_.assign(h_, 0.0);
     marginal_cdf_.assign(h_ + 1, 0.0);
     conditional_cdf_.assign(size_t(h_) * (w_ + 1), 0.0);
     for (int j = 0; j < h_; ++j) {
-        double st = std::sin((j + 0.5) / h_ * kPi);
+        // Exact solid angle of the row's pixels / (2π/W): cos θ_top − cos θ_bottom.
+        double st = std::cos(j * kPi / h_) - std::cos((j + 1) * kPi / h_);
+        row_dcos_[j] = st;
         double* cdf = &conditional_cdf_[size_t(j) * (w_ + 1)];
         cdf[0] = 0;
         for (int i = 0; i < w_; ++i) {
@@ -125,16 +128,18 @@ double EnvDistribution::sample(double u1, double u2, double dir[3]) const {
     while (i > 0 && cdf[i + 1] - cdf[i] <= 0) --i;
     while (i < w_ - 1 && cdf[i + 1] - cdf[i] <= 0) ++i;
     double du = std::clamp((s - cdf[i]) / (cdf[i + 1] - cdf[i]), 0.0, 1.0 - 1e-12);
-    double u = (i + du) / w_, v = (j + dv) / h_;
-    double phi = (u - 0.5) * 2 * kPi, theta = v * kPi;
-    double st = std::sin(theta);
-    if (st <= 0) return 0;
-    double e[3] = {st * std::sin(phi), std::cos(theta), -st * std::cos(phi)};
+    double u = (i + du) / w_;
+    double phi = (u - 0.5) * 2 * kPi;
+    // Uniform in solid angle inside the pixel: cos θ uniform between the row's edges.
+    double ct = std::cos(j * kPi / h_) - dv * row_dcos_[j];
+    ct = std::clamp(ct, -1.0, 1.0);
+    double st = std::sqrt(std::max(0.0, 1 - ct * ct));
+    double e[3] = {st * std::sin(phi), ct, -st * std::cos(phi)};
     // env -> world: R_y(+rotation)
     dir[0] = rot_c_ * e[0] + rot_s_ * e[2];
     dir[1] = e[1];
     dir[2] = -rot_s_ * e[0] + rot_c_ * e[2];
-    return prob_[size_t(j) * w_ + i] * double(w_) * h_ / (2 * kPi * kPi * st);
+    return prob_[size_t(j) * w_ + i] * double(w_) / (2 * kPi * row_dcos_[j]);
 }
 
 double EnvDistribution::pdf(const double d[3]) const {
@@ -142,12 +147,9 @@ double EnvDistribution::pdf(const double d[3]) const {
     // world -> env: R_y(-rotation)
     double x = rot_c_ * d[0] - rot_s_ * d[2], z = rot_s_ * d[0] + rot_c_ * d[2];
     double y = std::clamp(d[1], -1.0, 1.0);
-    double st = std::sqrt(std::max(0.0, x * x + z * z));
-    if (st <= 0) return 0;
     double u = 0.5 + std::atan2(x, -z) / (2 * kPi), v = std::acos(y) / kPi;
     int i = std::clamp(int(u * w_), 0, w_ - 1), j = std::clamp(int(v * h_), 0, h_ - 1);
-    double len = std::sqrt(x * x + y * y + z * z);
-    return prob_[size_t(j) * w_ + i] * double(w_) * h_ / (2 * kPi * kPi * (st / len));
+    return prob_[size_t(j) * w_ + i] * double(w_) / (2 * kPi * row_dcos_[j]);
 }
 
 } // namespace reference
@@ -173,6 +175,7 @@ struct Shader {
     const Environment& env;
     const EnvDistribution& dist;
     Lobes lobes;
+    bool power = true; // MIS heuristic: power (β = 2) or balance
 };
 
 void lookup(const Environment& env, V3 d, double rgb[3], long& fetches) {
@@ -280,7 +283,7 @@ void shade(const Shader& S, const Material& mat, V3 n, V3 v, uint32_t pix_seed, 
             V3 lw = to_world(l);
             double lwd[3] = {lw.x, lw.y, lw.z};
             double pe = S.dist.pdf(lwd);
-            double w = pb * pb / (pb * pb + pe * pe);
+            double w = S.power ? pb * pb / (pb * pb + pe * pe) : pb / (pb + pe);
             double fc[3], L[3];
             eval(l, fc);
             lookup(S.env, lw, L, fetches);
@@ -298,7 +301,7 @@ void shade(const Shader& S, const Material& mat, V3 n, V3 v, uint32_t pix_seed, 
             V3 ll{dot(lw, t), dot(lw, bt), dot(lw, n)};
             if (ll.z > 0) {
                 double pb = pdf_brdf(ll);
-                double w = pe * pe / (pe * pe + pb * pb);
+                double w = S.power ? pe * pe / (pe * pe + pb * pb) : pe / (pe + pb);
                 double fc[3], L[3];
                 eval(ll, fc);
                 lookup(S.env, lw, L, fetches);
@@ -326,6 +329,7 @@ ReferenceRender render_reference_full(const TestSpec& spec, const Environment* e
     int threads = o.get_int("threads", 0);
     double rot = o.get_double("env_rotation", 0.0);
     std::string lobes_s = o.get_choice("lobes", "all", {"all", "diffuse", "specular"});
+    std::string mis = o.get_choice("mis", "power", {"power", "balance"});
     if (spp < 1) throw UsageError("option 'spp': must be >= 1");
     if (threads < 0) throw UsageError("option 'threads': must be >= 0");
     Lobes lobes = lobes_s == "diffuse" ? Lobes::diffuse : lobes_s == "specular" ? Lobes::specular : Lobes::all;
@@ -342,7 +346,7 @@ ReferenceRender render_reference_full(const TestSpec& spec, const Environment* e
     cv::Mat image(H, W, CV_32FC3, cv::Scalar(0, 0, 0));
     cv::Mat coverage(H, W, CV_32FC1, cv::Scalar(0));
     std::vector<long> row_fetches(H, 0);
-    Shader S{env, dist, lobes};
+    Shader S{env, dist, lobes, mis == "power"};
     const uint32_t seed_hash = reference::hash_u32(uint32_t(seed) * 0x9e3779b9u + 0x85ebca6bu);
 
     std::atomic<int> next_row{0};
@@ -401,6 +405,7 @@ ReferenceRender render_reference_full(const TestSpec& spec, const Environment* e
         {"seed", seed},
         {"threads", threads},
         {"lobes", lobes_s},
+        {"mis", mis},
         {"env", {{"spec", env.spec.empty() ? spec.env : env.spec},
                  {"content_hash", env.content_hash},
                  {"source_path", env.source_path},

@@ -15,9 +15,14 @@
 //           (pdf = n·l/π); the strategy's pdf is the mixture p_s·pdf_vndf + (1−p_s)·pdf_cos.
 //           p_s = spec/(spec+diff) with spec = mean_c Schlick(F0_c, n·v), diff = mean_c (1−m)·c_c.
 //       (b) environment sampling: a piecewise-constant 2D distribution over the equirect pixels
-//           ∝ luminance·sin θ (marginal rows, conditional columns), where the luminance is taken as the
-//           3x3 maximum around each pixel so the distribution covers the bilinear footprint of bright
-//           pixels (the sun); pdf in solid angle = p(u,v)·W·H/(2π² sin θ).
+//           ∝ luminance·(solid angle of the pixel) (marginal rows, conditional columns), where the
+//           luminance is taken as the 3x3 maximum around each pixel so the distribution covers the
+//           bilinear footprint of bright pixels (the sun). The pixel's solid angle is the exact
+//           (2π/W)(cos θ_top − cos θ_bottom) rather than sin θ_centre·(2π/W)(π/H), and the direction is
+//           placed uniformly in SOLID ANGLE inside the pixel (cos θ uniform, φ uniform), so
+//           pdf(ω) = P_pixel / Ω_pixel — constant per pixel, no 1/sin θ spike at the poles. (Uniform-in-uv
+//           placement, pdf = p(u,v)·W·H/(2π² sin θ), was measured to double the noise of upward-facing
+//           normals in a constant environment.)
 //   * Mirror limit: for α < 1e-4 (roughness < 0.01, in practice r = 0) the specular lobe is the delta
 //     F(n·v)·L(reflect(v)) — one lookup, exact — and MIS (a)+(b) covers the diffuse lobe only.
 //     No α clamp anywhere else.
@@ -98,6 +103,7 @@ class EnvDistribution {
     std::vector<double> marginal_cdf_;    // h_ + 1
     std::vector<double> conditional_cdf_; // h_ * (w_ + 1)
     std::vector<double> prob_;            // w_ * h_, pixel probabilities
+    std::vector<double> row_dcos_;        // h_: cos θ_top − cos θ_bottom of each row
 };
 
 // Owen-scrambled shuffled Sobol pair (Burley 2020) in [0,1)², deterministic in (index, seed).
