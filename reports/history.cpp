@@ -1,0 +1,72 @@
+// The history file: JSON lines, one compact entry per run (reports/RESULTS_FORMAT.md, "History").
+#include <fstream>
+
+#include <fmt/format.h>
+
+#include "harness/common/errors.h"
+#include "reports/report_writer.h"
+
+namespace iblcheck::report {
+
+using json = nlohmann::json;
+
+std::vector<json> read_history(const std::filesystem::path& file) {
+    std::vector<json> out;
+    std::error_code ec;
+    if (!std::filesystem::exists(file, ec)) return out;
+    std::ifstream in(file, std::ios::binary);
+    if (!in) throw InputError(fmt::format("{}: cannot open the history file", file.string()));
+    std::string line;
+    size_t lineno = 0;
+    while (std::getline(in, line)) {
+        ++lineno;
+        if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+        json j;
+        try {
+            j = json::parse(line);
+        } catch (const json::parse_error& e) {
+            throw InputError(fmt::format("{}:{}: not a JSON line: {}", file.string(), lineno, e.what()));
+        }
+        if (!j.is_object() || !j.contains("tests") || !j["tests"].is_object())
+            throw InputError(fmt::format("{}:{}: a history line must be an object with a \"tests\" object",
+                                         file.string(), lineno));
+        out.push_back(std::move(j));
+    }
+    return out;
+}
+
+json history_entry(const json& results) {
+    json e = json::object();
+    auto str = [&](const char* k) { return results.contains(k) && results[k].is_string() ? results[k] : json(""); };
+    e["commit"] = str("commit");
+    e["dirty"] = results.value("dirty", false);
+    e["date"] = str("started");
+    e["suite"] = str("suite");
+    json tests = json::object();
+    if (results.contains("tests") && results["tests"].is_array())
+        for (const json& t : results["tests"]) {
+            if (!t.is_object() || !t.contains("name") || !t["name"].is_string()) continue;
+            json x = json::object();
+            x["verdict"] = t.value("verdict", "");
+            if (auto a = t.find("accuracy"); a != t.end() && a->is_object())
+                if (auto f = a->find("flip_mean"); f != a->end() && f->is_number()) x["flip_mean"] = *f;
+            for (const char* k : {"frame_ms", "precompute_ms"})
+                if (auto v = t.find(k); v != t.end() && v->is_number()) x[k] = *v;
+            if (auto tp = t.find("temporal"); tp != t.end() && tp->is_object())
+                if (auto f = tp->find("flicker"); f != tp->end() && f->is_number()) x["flicker"] = *f;
+            tests[t["name"].get<std::string>()] = std::move(x);
+        }
+    e["tests"] = std::move(tests);
+    return e;
+}
+
+void append_history(const std::filesystem::path& file, const json& entry) {
+    std::error_code ec;
+    if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path(), ec);
+    std::ofstream out(file, std::ios::binary | std::ios::app);
+    if (!out) throw Error(fmt::format("{}: cannot append to the history file", file.string()));
+    out << entry.dump(-1, ' ', false, json::error_handler_t::replace) << '\n';
+    if (!out) throw Error(fmt::format("{}: write failed", file.string()));
+}
+
+} // namespace iblcheck::report

@@ -1,0 +1,51 @@
+// The HTML report (issue 8): one static index.html per run, in the style of Blender's render test
+// report. It opens from the file system (file://), offline: CSS, JS and SVG charts are inline and
+// every image it shows is copied next to it. Failures come first, with the command to rebless.
+// The input is the results JSON the harness writes (reports/RESULTS_FORMAT.md) and, optionally,
+// the history file (JSON lines, one compact entry per run) for the trend sparklines.
+#pragma once
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace iblcheck::report {
+
+// Writes out_dir/index.html (creating out_dir). Image paths in `results` are relative to
+// `results_dir` (the folder that holds results.json); the images are copied to the same relative
+// paths under out_dir (kept in place when out_dir is results_dir), so out_dir is self-contained.
+// A missing image file is shown as a placeholder, not an error. `history`: entries as returned by
+// read_history (oldest first); the current run is added to the trend unless it is already the
+// last entry. Throws InputError naming results_dir/results.json and the problem when `results`
+// does not follow the schema; Error when out_dir cannot be written.
+void write_report(const nlohmann::json& results, const std::filesystem::path& results_dir,
+                  const std::filesystem::path& out_dir, const std::vector<nlohmann::json>& history = {});
+
+// Reads and validates a results file (InputError naming the file: unreadable, not JSON, schema).
+nlohmann::json read_results(const std::filesystem::path& results_file);
+
+// Checks `results` against schema iblcheck-results/1; throws InputError "<source>: <where>: <problem>".
+void validate_results(const nlohmann::json& results, const std::string& source);
+
+// History: JSON lines, one entry per run, oldest first. A missing file gives an empty history;
+// a malformed line throws InputError naming file and line.
+std::vector<nlohmann::json> read_history(const std::filesystem::path& file);
+
+// The compact line a run appends:
+// {"commit","dirty","date","suite","tests":{NAME:{"verdict","flip_mean","frame_ms","precompute_ms","flicker"}}}
+// (flip_mean is accuracy vs the reference golden; numbers absent from the results are left out).
+nlohmann::json history_entry(const nlohmann::json& results);
+
+// Appends `entry` as one line (creating the file and its folder).
+void append_history(const std::filesystem::path& file, const nlohmann::json& entry);
+
+} // namespace iblcheck::report
+
+namespace iblcheck {
+using report::append_history;
+using report::history_entry;
+using report::read_history;
+using report::read_results;
+using report::write_report;
+} // namespace iblcheck

@@ -1,0 +1,329 @@
+#include "reports/svg_chart.h"
+
+#include <algorithm>
+#include <cmath>
+#include <iterator>
+
+#include <fmt/format.h>
+
+namespace iblcheck::report {
+
+std::string html_escape(std::string_view s) {
+    std::string o;
+    o.reserve(s.size() + 8);
+    for (char c : s) {
+        switch (c) {
+        case '&': o += "&amp;"; break;
+        case '<': o += "&lt;"; break;
+        case '>': o += "&gt;"; break;
+        case '"': o += "&quot;"; break;
+        case '\'': o += "&#39;"; break;
+        default: o += c;
+        }
+    }
+    return o;
+}
+
+std::string fmt_num(double v) {
+    if (!std::isfinite(v)) return std::isnan(v) ? "NaN" : (v > 0 ? "inf" : "-inf");
+    if (v == 0) return "0";
+    const double a = std::fabs(v);
+    if (a >= 1e6 || a < 1e-4) return fmt::format("{:.3g}", v);
+    if (a >= 100) return fmt::format("{:.1f}", v);
+    return fmt::format("{:.4g}", v);
+}
+
+std::vector<size_t> pareto_front(const std::vector<std::pair<double, double>>& p) {
+    std::vector<size_t> front;
+    for (size_t i = 0; i < p.size(); ++i) {
+        bool dominated = false;
+        for (size_t j = 0; j < p.size() && !dominated; ++j) {
+            if (j == i) continue;
+            dominated = p[j].first <= p[i].first && p[j].second <= p[i].second &&
+                        (p[j].first < p[i].first || p[j].second < p[i].second);
+        }
+        if (!dominated) front.push_back(i);
+    }
+    return front;
+}
+
+namespace {
+
+struct Scale {
+    double lo = 0, hi = 1, p0 = 0, p1 = 1; // data domain -> pixel range
+    bool log = false;
+    std::vector<double> ticks;
+    double operator()(double v) const {
+        double t = log ? (std::log10(v) - std::log10(lo)) / (std::log10(hi) - std::log10(lo)) : (v - lo) / (hi - lo);
+        return p0 + t * (p1 - p0);
+    }
+};
+
+double nice_step(double raw) {
+    const double p = std::pow(10.0, std::floor(std::log10(raw)));
+    const double f = raw / p;
+    return (f < 1.5 ? 1 : f < 3 ? 2 : f < 7 ? 5 : 10) * p;
+}
+
+Scale make_scale(const ChartAxis& ax, std::vector<double> vals, double p0, double p1) {
+    Scale s;
+    s.p0 = p0;
+    s.p1 = p1;
+    s.log = ax.log;
+    double mn = vals.empty() ? (ax.log ? 1 : 0) : *std::min_element(vals.begin(), vals.end());
+    double mx = vals.empty() ? (ax.log ? 10 : 1) : *std::max_element(vals.begin(), vals.end());
+    if (ax.min) mn = *ax.min;
+    if (ax.max) mx = *ax.max;
+    if (ax.log) {
+        int e0 = int(std::floor(std::log10(mn))), e1 = int(std::ceil(std::log10(mx)));
+        if (e1 <= e0) e1 = e0 + 1;
+        s.lo = std::pow(10.0, e0);
+        s.hi = std::pow(10.0, e1);
+        const bool fine = e1 - e0 <= 2;
+        for (int e = e0; e <= e1; ++e)
+            for (double m : {1.0, 2.0, 5.0}) {
+                if (m != 1.0 && !fine) continue;
+                const double v = m * std::pow(10.0, e);
+                if (v >= s.lo * 0.999 && v <= s.hi * 1.001) s.ticks.push_back(v);
+            }
+        return s;
+    }
+    if (!ax.min && mn >= 0) mn = 0; // errors and costs: start at 0
+    if (mx <= mn) mx = mn + (std::fabs(mn) > 0 ? std::fabs(mn) * 0.5 : 1.0);
+    const double step = nice_step((mx - mn) / 5);
+    s.lo = ax.min ? mn : std::floor(mn / step) * step;
+    s.hi = ax.max ? mx : std::ceil(mx / step - 1e-9) * step;
+    if (s.hi <= s.lo) s.hi = s.lo + step;
+    for (double v = std::ceil(s.lo / step - 1e-9) * step; v <= s.hi + step * 1e-6; v += step)
+        s.ticks.push_back(std::fabs(v) < step * 1e-9 ? 0 : v);
+    return s;
+}
+
+struct Box {
+    double x0, y0, x1, y1;
+    bool hits(const Box& o) const { return x0 < o.x1 && o.x0 < x1 && y0 < o.y1 && o.y0 < y1; }
+};
+
+} // namespace
+
+std::string render_chart(const Chart& c) {
+    // Points that a log axis cannot show (<= 0) or that are not finite are left out and counted.
+    struct P {
+        const ChartPoint* p;
+        size_t series;
+    };
+    std::vector<P> pts;
+    std::vector<double> xs, ys;
+    size_t skipped = 0;
+    for (size_t si = 0; si < c.series.size(); ++si)
+        for (const ChartPoint& p : c.series[si].points) {
+            if (!std::isfinite(p.x) || !std::isfinite(p.y) || (c.x.log && p.x <= 0) || (c.y.log && p.y <= 0)) {
+                ++skipped;
+                continue;
+            }
+            pts.push_back({&p, si});
+            xs.push_back(p.x);
+            ys.push_back(p.y);
+        }
+
+    const double W = 820, legend_x = 600, px0 = 70, px1 = 580, py0 = 48;
+    const double H = std::max(400.0, 60.0 + 18.0 * double(c.series.size() + (c.pareto ? 1 : 0)));
+    const double py1 = H - 70;
+    const Scale sx = make_scale(c.x, xs, px0, px1);
+    const Scale sy = make_scale(c.y, ys, py1, py0);
+
+    std::string o;
+    auto out = std::back_inserter(o);
+    fmt::format_to(out,
+                   "<svg class=\"chart\" data-chart=\"{}\" data-points=\"{}\" data-series=\"{}\" data-skipped=\"{}\" "
+                   "xmlns=\"http://www.w3.org/2000/svg\" width=\"{}\" height=\"{}\" viewBox=\"0 0 {} {}\" role=\"img\">\n",
+                   html_escape(c.id), pts.size(), c.series.size(), skipped, W, H, W, H);
+    fmt::format_to(out, "<title>{}</title>\n", html_escape(c.title));
+    fmt::format_to(out, "<text class=\"ctitle\" x=\"{}\" y=\"20\">{}</text>\n", px0, html_escape(c.title));
+    if (!c.note.empty())
+        fmt::format_to(out, "<text class=\"cnote\" x=\"{}\" y=\"36\">{}</text>\n", px0, html_escape(c.note));
+    // Frame, grid, ticks.
+    fmt::format_to(out, "<rect class=\"plot\" x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\"/>\n", px0, py0, px1 - px0,
+                   py1 - py0);
+    for (double t : sx.ticks) {
+        const double x = sx(t);
+        fmt::format_to(out,
+                       "<line class=\"grid\" x1=\"{0:.1f}\" y1=\"{1}\" x2=\"{0:.1f}\" y2=\"{2}\"/>"
+                       "<line class=\"tick\" x1=\"{0:.1f}\" y1=\"{2}\" x2=\"{0:.1f}\" y2=\"{3}\"/>"
+                       "<text class=\"tl\" x=\"{0:.1f}\" y=\"{4}\" text-anchor=\"middle\">{5}</text>\n",
+                       x, py0, py1, py1 + 5, py1 + 18, fmt_num(t));
+    }
+    for (double t : sy.ticks) {
+        const double y = sy(t);
+        fmt::format_to(out,
+                       "<line class=\"grid\" x1=\"{1}\" y1=\"{0:.1f}\" x2=\"{2}\" y2=\"{0:.1f}\"/>"
+                       "<line class=\"tick\" x1=\"{3}\" y1=\"{0:.1f}\" x2=\"{1}\" y2=\"{0:.1f}\"/>"
+                       "<text class=\"tl\" x=\"{4}\" y=\"{5:.1f}\" text-anchor=\"end\">{6}</text>\n",
+                       y, px0, px1, px0 - 5, px0 - 8, y + 4, fmt_num(t));
+    }
+    fmt::format_to(out, "<text class=\"al\" x=\"{}\" y=\"{}\" text-anchor=\"middle\">{}{}</text>\n", (px0 + px1) / 2,
+                   py1 + 40, html_escape(c.x.label), c.x.log ? " (log scale)" : "");
+    fmt::format_to(out,
+                   "<text class=\"al\" transform=\"translate(16 {}) rotate(-90)\" text-anchor=\"middle\">{}{}</text>\n",
+                   (py0 + py1) / 2, html_escape(c.y.label), c.y.log ? " (log scale)" : "");
+    if (pts.empty())
+        fmt::format_to(out, "<text class=\"cnote\" x=\"{}\" y=\"{}\" text-anchor=\"middle\">no data</text>\n",
+                       (px0 + px1) / 2, (py0 + py1) / 2);
+
+    // Pareto front: staircase through the non-dominated points (everything above/right is worse).
+    if (c.pareto && !pts.empty()) {
+        std::vector<std::pair<double, double>> xy;
+        for (auto& p : pts) xy.emplace_back(p.p->x, p.p->y);
+        std::vector<size_t> f = pareto_front(xy);
+        std::sort(f.begin(), f.end(), [&](size_t a, size_t b) { return xy[a] < xy[b]; });
+        std::string poly;
+        for (size_t k = 0; k < f.size(); ++k) {
+            const double x = sx(xy[f[k]].first), y = sy(xy[f[k]].second);
+            if (k > 0) poly += fmt::format("{:.1f},{:.1f} ", x, sy(xy[f[k - 1]].second));
+            poly += fmt::format("{:.1f},{:.1f} ", x, y);
+        }
+        if (!f.empty()) {
+            poly += fmt::format("{:.1f},{:.1f}", px1, sy(xy[f.back()].second));
+            std::string members;
+            for (size_t k : f) members += (members.empty() ? "" : "; ") + pts[k].p->label;
+            fmt::format_to(out,
+                           "<polyline class=\"pareto-front\" data-front=\"{}\" points=\"{}\"><title>Pareto front: {}"
+                           "</title></polyline>\n",
+                           f.size(), poly, html_escape(members));
+            for (size_t k : f)
+                fmt::format_to(out, "<circle class=\"front-ring\" cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"7\"/>\n",
+                               sx(xy[k].first), sy(xy[k].second));
+        }
+    }
+
+    // Lines, then points and labels (labels avoid each other greedily; the tooltip always has it).
+    for (size_t si = 0; si < c.series.size(); ++si) {
+        const ChartSeries& s = c.series[si];
+        if (!s.connect) continue;
+        std::vector<std::pair<double, double>> xy;
+        for (auto& p : pts)
+            if (p.series == si) xy.emplace_back(p.p->x, p.p->y);
+        std::sort(xy.begin(), xy.end());
+        if (xy.size() < 2) continue;
+        std::string poly;
+        for (auto& [x, y] : xy) poly += fmt::format("{:.1f},{:.1f} ", sx(x), sy(y));
+        fmt::format_to(out,
+                       "<polyline class=\"series{}\" data-series=\"{}\" stroke=\"{}\" points=\"{}\"><title>{}</title>"
+                       "</polyline>\n",
+                       s.dashed ? " dashed" : "", html_escape(s.name), html_escape(s.color), poly, html_escape(s.name));
+    }
+    std::vector<Box> placed;
+    for (auto& p : pts) {
+        const ChartSeries& s = c.series[p.series];
+        const double x = sx(p.p->x), y = sy(p.p->y);
+        std::string circle = fmt::format(
+            "<circle class=\"point\" cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"4.5\" fill=\"{}\" data-series=\"{}\" "
+            "data-x=\"{}\" data-y=\"{}\" data-label=\"{}\"><title>{}</title></circle>",
+            x, y, html_escape(s.color), html_escape(s.name), p.p->x, p.p->y, html_escape(p.p->label),
+            html_escape(p.p->tooltip.empty() ? p.p->label : p.p->tooltip));
+        if (!p.p->href.empty())
+            circle = fmt::format("<a href=\"{}\">{}</a>", html_escape(p.p->href), circle);
+        o += circle;
+        placed.push_back({x - 5, y - 5, x + 5, y + 5});
+        if (!p.p->label.empty()) {
+            const double w = 5.6 * double(p.p->label.size()), h = 11;
+            for (double dy : {-6.0, 6.0, -17.0, 17.0, -28.0, 28.0}) {
+                double lx = x + 7, ly = y + dy;
+                if (lx + w > px1 + 15) lx = x - 7 - w; // keep labels inside the plot
+                Box b{lx, ly - h + 2, lx + w, ly + 2};
+                if (b.y0 < py0 || b.y1 > py1) continue;
+                if (std::any_of(placed.begin(), placed.end(), [&](const Box& q) { return q.hits(b); })) continue;
+                placed.push_back(b);
+                fmt::format_to(out, "<text class=\"pl\" x=\"{:.1f}\" y=\"{:.1f}\">{}</text>", lx, ly,
+                               html_escape(p.p->label));
+                break;
+            }
+        }
+        o += '\n';
+    }
+
+    // Legend.
+    double ly = py0 + 6;
+    for (const ChartSeries& s : c.series) {
+        fmt::format_to(out,
+                       "<g class=\"legend\"><line class=\"series{}\" x1=\"{}\" y1=\"{}\" x2=\"{}\" y2=\"{}\" "
+                       "stroke=\"{}\"/><circle cx=\"{}\" cy=\"{}\" r=\"4\" fill=\"{}\"/><text x=\"{}\" y=\"{}\">{}"
+                       "</text></g>\n",
+                       s.dashed ? " dashed" : "", legend_x, ly, legend_x + 22, ly, html_escape(s.color),
+                       legend_x + 11, ly, html_escape(s.color), legend_x + 28, ly + 4, html_escape(s.name));
+        ly += 18;
+    }
+    if (c.pareto)
+        fmt::format_to(out,
+                       "<g class=\"legend\"><line class=\"pareto-front\" x1=\"{}\" y1=\"{}\" x2=\"{}\" y2=\"{}\"/>"
+                       "<text x=\"{}\" y=\"{}\">Pareto front (lower-left is better)</text></g>\n",
+                       legend_x, ly, legend_x + 22, ly, legend_x + 28, ly + 4);
+    o += "</svg>\n";
+    return o;
+}
+
+Sparkline render_sparkline(const std::string& id, const std::string& test_name, const std::vector<SparkRun>& runs,
+                           double rel_threshold, double abs_floor, const std::string& unit) {
+    Sparkline r;
+    const double W = 200, H = 44, x0 = 4, x1 = W - 4, y0 = 13, y1 = H - 4;
+    std::vector<size_t> idx;
+    for (size_t i = 0; i < runs.size(); ++i)
+        if (runs[i].value && std::isfinite(*runs[i].value)) idx.push_back(i);
+    r.points = idx.size();
+    double mn = 0, mx = 1;
+    if (!idx.empty()) {
+        mn = mx = *runs[idx[0]].value;
+        for (size_t i : idx) mn = std::min(mn, *runs[i].value), mx = std::max(mx, *runs[i].value);
+    }
+    if (mx - mn < 1e-12) mn -= 0.5 * std::max(std::fabs(mn), 1e-6), mx += 0.5 * std::max(std::fabs(mx), 1e-6);
+    const double n = double(std::max<size_t>(runs.size(), 2) - 1);
+    auto X = [&](size_t i) { return x0 + (x1 - x0) * double(i) / n; };
+    auto Y = [&](double v) { return y1 - (y1 - y0) * (v - mn) / (mx - mn); };
+
+    // Largest relative jump between consecutive present values.
+    double best = 0;
+    size_t best_i = 0;
+    for (size_t k = 1; k < idx.size(); ++k) {
+        const double a = *runs[idx[k - 1]].value, b = *runs[idx[k]].value;
+        const double d = std::fabs(b - a);
+        if (d < abs_floor) continue;
+        const double rel = d / std::max({std::fabs(a), 1e-12});
+        if (rel > best) best = rel, best_i = k;
+    }
+    std::string o;
+    auto out = std::back_inserter(o);
+    fmt::format_to(out,
+                   "<svg class=\"chart spark\" data-chart=\"{}\" data-test=\"{}\" data-points=\"{}\" "
+                   "xmlns=\"http://www.w3.org/2000/svg\" width=\"{}\" height=\"{}\" viewBox=\"0 0 {} {}\">",
+                   html_escape(id), html_escape(test_name), idx.size(), W, H, W, H);
+    if (best > rel_threshold && best_i > 0) {
+        const SparkRun& run = runs[idx[best_i]];
+        const double a = *runs[idx[best_i - 1]].value, b = *run.value;
+        r.moved_commit = run.commit;
+        r.moved = fmt::format("{}{:.0f}% at {}", b >= a ? "+" : "\u2212", 100 * best, run.commit);
+        const double x = X(idx[best_i]);
+        fmt::format_to(out,
+                       "<line class=\"moved\" x1=\"{0:.1f}\" y1=\"9\" x2=\"{0:.1f}\" y2=\"{1}\"/>"
+                       "<text class=\"moved\" x=\"{2:.1f}\" y=\"9\" text-anchor=\"{3}\" data-commit=\"{4}\">{4}</text>",
+                       x, H, x, x > W / 2 ? "end" : "start", html_escape(run.commit));
+    }
+    if (idx.size() >= 2) {
+        std::string poly;
+        for (size_t i : idx) poly += fmt::format("{:.1f},{:.1f} ", X(i), Y(*runs[i].value));
+        fmt::format_to(out, "<polyline class=\"sl\" points=\"{}\"/>", poly);
+    }
+    for (size_t k = 0; k < idx.size(); ++k) {
+        const SparkRun& run = runs[idx[k]];
+        fmt::format_to(out,
+                       "<circle class=\"point{}\" cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"{}\" data-commit=\"{}\" data-y=\"{}\">"
+                       "<title>{} {}: {}{}</title></circle>",
+                       k + 1 == idx.size() ? " last" : "", X(idx[k]), Y(*run.value), k + 1 == idx.size() ? 3 : 1.8,
+                       html_escape(run.commit), *run.value, html_escape(run.commit), html_escape(run.date),
+                       fmt_num(*run.value), html_escape(unit));
+    }
+    o += "</svg>";
+    r.svg = std::move(o);
+    return r;
+}
+
+} // namespace iblcheck::report
