@@ -379,19 +379,36 @@ void test_card(std::string& o, const json& t, size_t idx, ImageStore& store, con
     const json& acc = sub(t, "accuracy");
     const json& ps = sub(t, "per_sphere");
     if (num(acc, "flip_mean") || (ps.is_array() && !ps.empty())) {
-        o += "<div><h4>Accuracy vs the reference</h4>";
+        fmt::format_to(out, "<div><h4>Accuracy vs the reference{}</h4>",
+                       ps.is_array() && !ps.empty() ? " (FLIP mean per sphere)" : "");
         if (auto f = num(acc, "flip_mean"))
             fmt::format_to(out, "<div class=\"meta\">FLIP mean <b>{}</b>{}</div>", fmt_num(*f),
                            str(acc, "golden").empty() ? ""
                                                       : " against <span class=\"mono\">" + e(str(acc, "golden")) + "</span>");
         if (ps.is_array() && !ps.empty()) {
-            o += "<table class=\"grid spheres\"><tr><th>sphere</th><th>roughness</th><th>metallic</th><th>FLIP mean</th></tr>";
-            for (const json& s : ps)
-                fmt::format_to(out, "<tr><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}"
-                                    "</td></tr>",
-                               e(str(s, "label")), fmt_num(num(s, "roughness").value_or(0)),
-                               num(s, "metallic") ? fmt_num(*num(s, "metallic")) : "&ndash;",
-                               fmt_num(num(s, "flip_mean").value_or(0)));
+            // Compact: one row per material class, one column per roughness.
+            std::map<double, std::map<int, std::vector<const json*>>> grid; // roughness -> metal? -> spheres
+            for (const json& sp : ps)
+                grid[num(sp, "roughness").value_or(0)][num(sp, "metallic").value_or(0) >= 0.5 ? 1 : 0].push_back(&sp);
+            o += "<table class=\"grid spheres\"><tr><th>roughness</th>";
+            for (auto& [r, _] : grid) fmt::format_to(out, "<th class=\"num\">{}</th>", fmt_num(r));
+            o += "</tr>";
+            for (int metal : {1, 0}) {
+                bool any = false;
+                for (auto& [r, byclass] : grid) any = any || byclass.count(metal);
+                if (!any) continue;
+                fmt::format_to(out, "<tr><th>{}</th>", metal ? "metal" : "dielectric");
+                for (auto& [r, byclass] : grid) {
+                    std::string cell, tip;
+                    if (auto it = byclass.find(metal); it != byclass.end())
+                        for (const json* sp : it->second) {
+                            cell += (cell.empty() ? "" : " / ") + fmt_num(num(*sp, "flip_mean").value_or(0));
+                            tip += (tip.empty() ? "" : "; ") + str(*sp, "label");
+                        }
+                    fmt::format_to(out, "<td class=\"num\" title=\"{}\">{}</td>", e(tip), cell.empty() ? "&ndash;" : cell);
+                }
+                o += "</tr>";
+            }
             o += "</table>";
         }
         o += "</div>";
@@ -700,7 +717,9 @@ void write_report(const json& results, const fs::path& results_dir, const fs::pa
                            "href=\"#{3}\">{1}</a></td><td><span class=\"vstrip\">{4}</span></td><td>{5}</td><td "
                            "class=\"moved-txt\">{6}</td><td>{7}</td><td class=\"moved-txt\">{8}</td></tr>\n",
                            i, e(str(*tests[i], "name")), e(v), test_id(i), tr.verdict_strip,
-                           tr.flip.points ? tr.flip.svg : "", e(tr.flip.moved), tr.frame.points ? tr.frame.svg : "",
+                           tr.flip.points ? tr.flip.svg + " <span class=\"meta\">" + e(tr.flip.range) + "</span>" : "",
+                           e(tr.flip.moved),
+                           tr.frame.points ? tr.frame.svg + " <span class=\"meta\">" + e(tr.frame.range) + "</span>" : "",
                            e(tr.frame.moved));
         }
         o += "</table>\n";

@@ -29,7 +29,7 @@ std::string fmt_num(double v) {
     if (v == 0) return "0";
     const double a = std::fabs(v);
     if (a >= 1e6 || a < 1e-4) return fmt::format("{:.3g}", v);
-    if (a >= 100) return fmt::format("{:.1f}", v);
+    if (a >= 100) return v == std::round(v) ? fmt::format("{:.0f}", v) : fmt::format("{:.1f}", v);
     return fmt::format("{:.4g}", v);
 }
 
@@ -90,6 +90,7 @@ Scale make_scale(const ChartAxis& ax, std::vector<double> vals, double p0, doubl
     }
     if (!ax.min && mn >= 0) mn = 0; // errors and costs: start at 0
     if (mx <= mn) mx = mn + (std::fabs(mn) > 0 ? std::fabs(mn) * 0.5 : 1.0);
+    if (!ax.max && !vals.empty()) mx += 0.06 * (mx - mn); // keep the top point off the frame
     const double step = nice_step((mx - mn) / 5);
     s.lo = ax.min ? mn : std::floor(mn / step) * step;
     s.hi = ax.max ? mx : std::ceil(mx / step - 1e-9) * step;
@@ -126,9 +127,25 @@ std::string render_chart(const Chart& c) {
             ys.push_back(p.y);
         }
 
-    const double W = 820, legend_x = 600, px0 = 70, px1 = 580, py0 = 48;
-    const double H = std::max(400.0, 60.0 + 18.0 * double(c.series.size() + (c.pareto ? 1 : 0)));
-    const double py1 = H - 70;
+    // Layout: plot on top, legend below it in rows that wrap (so two charts fit side by side).
+    const double W = 640, px0 = 64, px1 = W - 24, py0 = 48, py1 = 310;
+    struct LegendItem {
+        std::string name, color;
+        bool dashed, pareto;
+        double x, y;
+    };
+    std::vector<LegendItem> legend;
+    for (const ChartSeries& s : c.series) legend.push_back({s.name, s.color, s.dashed, false, 0, 0});
+    if (c.pareto) legend.push_back({"Pareto front (lower-left is better)", "#212529", true, true, 0, 0});
+    double lx = px0 - 40, ly = py1 + 64;
+    for (LegendItem& it : legend) {
+        const double w = 34 + 6.1 * double(it.name.size()) + 14;
+        if (lx + w > W - 4 && lx > px0 - 40) lx = px0 - 40, ly += 18;
+        it.x = lx;
+        it.y = ly;
+        lx += w;
+    }
+    const double H = ly + 14;
     const Scale sx = make_scale(c.x, xs, px0, px1);
     const Scale sy = make_scale(c.y, ys, py1, py0);
 
@@ -214,6 +231,10 @@ std::string render_chart(const Chart& c) {
     }
     std::vector<Box> placed;
     for (auto& p : pts) {
+        const double x = sx(p.p->x), y = sy(p.p->y);
+        placed.push_back({x - 5, y - 5, x + 5, y + 5}); // labels keep off every point
+    }
+    for (auto& p : pts) {
         const ChartSeries& s = c.series[p.series];
         const double x = sx(p.p->x), y = sy(p.p->y);
         std::string circle = fmt::format(
@@ -224,7 +245,6 @@ std::string render_chart(const Chart& c) {
         if (!p.p->href.empty())
             circle = fmt::format("<a href=\"{}\">{}</a>", html_escape(p.p->href), circle);
         o += circle;
-        placed.push_back({x - 5, y - 5, x + 5, y + 5});
         if (!p.p->label.empty()) {
             const double w = 5.6 * double(p.p->label.size()), h = 11;
             for (double dy : {-6.0, 6.0, -17.0, 17.0, -28.0, 28.0}) {
@@ -243,21 +263,20 @@ std::string render_chart(const Chart& c) {
     }
 
     // Legend.
-    double ly = py0 + 6;
-    for (const ChartSeries& s : c.series) {
-        fmt::format_to(out,
-                       "<g class=\"legend\"><line class=\"series{}\" x1=\"{}\" y1=\"{}\" x2=\"{}\" y2=\"{}\" "
-                       "stroke=\"{}\"/><circle cx=\"{}\" cy=\"{}\" r=\"4\" fill=\"{}\"/><text x=\"{}\" y=\"{}\">{}"
-                       "</text></g>\n",
-                       s.dashed ? " dashed" : "", legend_x, ly, legend_x + 22, ly, html_escape(s.color),
-                       legend_x + 11, ly, html_escape(s.color), legend_x + 28, ly + 4, html_escape(s.name));
-        ly += 18;
+    for (const LegendItem& it : legend) {
+        if (it.pareto)
+            fmt::format_to(out,
+                           "<g class=\"legend\"><line class=\"pareto-front\" x1=\"{0:.1f}\" y1=\"{1:.1f}\" x2=\"{2:.1f}\" "
+                           "y2=\"{1:.1f}\"/><text x=\"{3:.1f}\" y=\"{4:.1f}\">{5}</text></g>\n",
+                           it.x, it.y, it.x + 26, it.x + 32, it.y + 4, html_escape(it.name));
+        else
+            fmt::format_to(out,
+                           "<g class=\"legend\"><line class=\"series{0}\" x1=\"{1:.1f}\" y1=\"{2:.1f}\" x2=\"{3:.1f}\" "
+                           "y2=\"{2:.1f}\" stroke=\"{4}\"/><circle cx=\"{5:.1f}\" cy=\"{2:.1f}\" r=\"4\" fill=\"{4}\"/>"
+                           "<text x=\"{6:.1f}\" y=\"{7:.1f}\">{8}</text></g>\n",
+                           it.dashed ? " dashed" : "", it.x, it.y, it.x + 26, html_escape(it.color), it.x + 13,
+                           it.x + 32, it.y + 4, html_escape(it.name));
     }
-    if (c.pareto)
-        fmt::format_to(out,
-                       "<g class=\"legend\"><line class=\"pareto-front\" x1=\"{}\" y1=\"{}\" x2=\"{}\" y2=\"{}\"/>"
-                       "<text x=\"{}\" y=\"{}\">Pareto front (lower-left is better)</text></g>\n",
-                       legend_x, ly, legend_x + 22, ly, legend_x + 28, ly + 4);
     o += "</svg>\n";
     return o;
 }
@@ -275,7 +294,15 @@ Sparkline render_sparkline(const std::string& id, const std::string& test_name, 
         mn = mx = *runs[idx[0]].value;
         for (size_t i : idx) mn = std::min(mn, *runs[i].value), mx = std::max(mx, *runs[i].value);
     }
-    if (mx - mn < 1e-12) mn -= 0.5 * std::max(std::fabs(mn), 1e-6), mx += 0.5 * std::max(std::fabs(mx), 1e-6);
+    if (!idx.empty()) r.range = fmt::format("{}–{}{}", fmt_num(mn), fmt_num(mx), unit);
+    // The vertical span is at least 20 % of the values (and abs_floor), so run-to-run noise of a
+    // few percent reads as flat instead of being stretched to the full height.
+    const double min_span = std::max({0.2 * std::max(std::fabs(mn), std::fabs(mx)), 2 * abs_floor, 1e-9});
+    if (mx - mn < min_span) {
+        const double mid = 0.5 * (mn + mx);
+        mn = mid - 0.5 * min_span;
+        mx = mid + 0.5 * min_span;
+    }
     const double n = double(std::max<size_t>(runs.size(), 2) - 1);
     auto X = [&](size_t i) { return x0 + (x1 - x0) * double(i) / n; };
     auto Y = [&](double v) { return y1 - (y1 - y0) * (v - mn) / (mx - mn); };

@@ -60,6 +60,7 @@ struct Sparkline {
     std::string svg;
     std::string moved;      // "+35% at f554dd9" when the largest jump passes the threshold; else ""
     std::string moved_commit;
+    std::string range;      // "0.03–0.052 ms": the values' span
     size_t points = 0;
 };
 
