@@ -37,7 +37,8 @@ nav.toc a{margin-right:14px}
 section.test{background:#fff;border:1px solid var(--line);border-left:6px solid var(--pass);border-radius:6px;padding:12px 16px;margin:14px 0}
 section.test.s-fail{border-left-color:var(--fail)}section.test.s-error{border-left-color:var(--error)}section.test.s-missing-golden{border-left-color:var(--missing)}section.test.s-improved{border-left-color:var(--improved)}
 .meta{color:var(--mut);font-size:12.5px;margin:2px 0 6px}
-.message{margin:6px 0;white-space:pre-wrap;font-family:"DejaVu Sans Mono",monospace;font-size:12.5px}
+table.overview{width:100%}td.msg{overflow-wrap:anywhere;font-size:12px;color:#495057;min-width:240px}
+.message{margin:6px 0;white-space:pre-wrap;overflow-wrap:anywhere;font-family:"DejaVu Sans Mono",monospace;font-size:12.5px}
 .warn{background:#fff3bf;border:1px solid #fab005;border-radius:4px;padding:5px 10px;margin:6px 0}
 .images{display:flex;gap:14px;flex-wrap:wrap;align-items:flex-start;overflow-x:auto}
 figure{margin:0}figcaption{font-size:12px;color:var(--mut);margin-top:2px}

@@ -110,6 +110,10 @@ class ImageStore {
         return result;
     }
     const std::vector<std::string>& missing() const { return missing_; }
+    bool exists(const std::string& rel) const {
+        std::error_code ec;
+        return fs::is_regular_file(results_dir_ / rel, ec);
+    }
 
   private:
     fs::path results_dir_, out_dir_;
@@ -169,9 +173,10 @@ std::string img_or_missing(ImageStore& store, const std::string& rel, const char
 void comparison_html(std::string& o, const json& t, const json& cmp, ImageStore& store) {
     auto out = std::back_inserter(o);
     const std::string kind = str(cmp, "kind"), cv = str(cmp, "verdict");
-    fmt::format_to(out, "<h4>{} comparison{}{}{}</h4>\n", e(kind),
+    fmt::format_to(out, "<h4>{} comparison{}{}{}</h4>\n", e(kind) + (str(cmp, "label").empty() ? "" : " (" + e(str(cmp, "label")) + ")"),
                    cmp.contains("golden") ? " against <span class=\"mono\">" + e(str(cmp, "golden")) + "</span>" : "",
                    cv.empty() ? "" : fmt::format(" <span class=\"badge v-{}\">{}</span>", e(cv), e(cv)), "");
+    if (!str(cmp, "message").empty()) fmt::format_to(out, "<div class=\"message\">{}</div>\n", e(str(cmp, "message")));
     const json& imgs = sub(cmp, "images");
     const std::string ti = str(imgs, "test"), gi = str(imgs, "golden"), hi = str(imgs, "heatmap");
     if (!ti.empty() || !gi.empty() || !hi.empty()) {
@@ -335,6 +340,18 @@ void temporal_html(std::string& o, const json& tp, ImageStore& store) {
     o += "</div>";
 }
 
+// The overview shows the first line of a message, cut at a word near 160 characters (UTF-8 safe).
+std::string short_message(const std::string& m) {
+    std::string s = m.substr(0, m.find('\n'));
+    if (s.size() <= 160) return s == m ? s : s + " \u2026";
+    size_t cut = s.rfind(' ', 160);
+    if (cut == std::string::npos || cut < 100) {
+        cut = 160;
+        while (cut > 0 && (static_cast<unsigned char>(s[cut]) & 0xC0) == 0x80) --cut;
+    }
+    return s.substr(0, cut) + " \u2026";
+}
+
 std::string test_id(size_t i) { return fmt::format("t-{}", i); }
 
 void test_card(std::string& o, const json& t, size_t idx, ImageStore& store, const Trend& trend) {
@@ -372,8 +389,23 @@ void test_card(std::string& o, const json& t, size_t idx, ImageStore& store, con
                                              : "If this change is intended, rebless:",
                        e(str(t, "bless_command")));
     const json& comps = sub(t, "comparisons");
+    bool shown = false;
     if (comps.is_array())
-        for (const json& c : comps) comparison_html(o, t, c, store);
+        for (const json& c : comps) {
+            comparison_html(o, t, c, store);
+            shown = shown || !str(sub(c, "images"), "test").empty();
+        }
+    // No comparison shows the rendering (missing golden, size mismatch): show the test image alone,
+    // from "image" or, failing that, images/<name>/test.png when that file exists.
+    if (!shown) {
+        std::string rel = str(t, "image");
+        if (rel.empty() && !name.empty() && name.find('/') == std::string::npos && name != "." && name != "..")
+            if (store.exists("images/" + name + "/test.png")) rel = "images/" + name + "/test.png";
+        if (!rel.empty())
+            fmt::format_to(out, "<div class=\"images\"><figure>{}<figcaption>test image{}</figcaption></figure></div>\n",
+                           img_or_missing(store, rel, "t", "test"),
+                           v == "missing-golden" ? " (no golden to compare with yet)" : "");
+    }
     o += "<div class=\"cols\">";
     timings_html(o, t);
     const json& acc = sub(t, "accuracy");
@@ -504,7 +536,10 @@ void write_report(const json& results, const fs::path& results_dir, const fs::pa
     const json current = history_entry(results);
     History hist;
     std::vector<const json*> all;
-    for (const json& h : history) all.push_back(&h);
+    // Runs of other suites (one history file may serve several) are left out of the trend.
+    for (const json& h : history)
+        if (str(h, "suite").empty() || str(current, "suite").empty() || str(h, "suite") == str(current, "suite"))
+            all.push_back(&h);
     if (all.empty() || str(*all.back(), "commit") != str(current, "commit") ||
         str(*all.back(), "date") != str(current, "date"))
         all.push_back(&current);
@@ -598,11 +633,12 @@ void write_report(const json& results, const fs::path& results_dir, const fs::pa
         fmt::format_to(out,
                        "<tr class=\"filterable\" data-name=\"{2}\" data-verdict=\"{0}\"><td><span class=\"badge v-{0}\">"
                        "{0}</span></td><td><a href=\"#{1}\">{2}</a></td><td class=\"num\">{3}</td><td class=\"num\">{4}"
-                       "</td><td class=\"num\">{5}</td><td class=\"num\">{6}</td><td class=\"num\">{7}</td><td>{8}</td></tr>\n",
+                       "</td><td class=\"num\">{5}</td><td class=\"num\">{6}</td><td class=\"num\">{7}</td><td class=\"msg\" "
+                       "title=\"{9}\">{8}</td></tr>\n",
                        e(v), test_id(i), e(str(t, "name")), cellnum(golden_flip),
                        cellnum(num(sub(t, "accuracy"), "flip_mean")), cellnum(num(t, "frame_ms")),
                        cellnum(num(t, "precompute_ms")), cellnum(num(t, "texture_fetches_per_pixel")),
-                       e(str(t, "message")));
+                       e(short_message(str(t, "message"))), e(str(t, "message")));
     }
     o += "</table>\n";
 
