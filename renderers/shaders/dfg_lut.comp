@@ -3,7 +3,8 @@
 // (n·v, r): with F = F0 + (1 − F0)Fc, ∫ f cos = F0·A + B where
 //   A = ∫ (1 − Fc) V 4 (v·h)(n·l)/(n·h),   B = ∫ Fc V 4 (v·h)(n·l)/(n·h),   Fc = (1 − v·h)^5,
 // estimated with GGX samples (pdf D(n·h)) and the model's height-correlated V. Stored RG16F;
-// texel (i, j) holds n·v = (i + 0.5)/size, r = (j + 0.5)/size, read back with bilinear filtering.
+// texel (i, j) holds n·v = i/(size − 1), r = j/(size − 1), so the table's end points are exact
+// (r = 1 is on a texel centre, not half a texel inside); lookups use dfg_lut_uv() (env_brdf.glsl).
 #include "common.glsl"
 #include "brdf.glsl"
 
@@ -14,8 +15,8 @@ layout(push_constant) uniform Push { uint size; uint sample_count; } pc;
 void main() {
     uvec2 t = gl_GlobalInvocationID.xy;
     if (t.x >= pc.size || t.y >= pc.size) return;
-    float n_dot_v = (float(t.x) + 0.5) / float(pc.size);
-    float r = (float(t.y) + 0.5) / float(pc.size);
+    float n_dot_v = max(float(t.x) / float(pc.size - 1u), 1e-4);
+    float r = float(t.y) / float(pc.size - 1u);
     float alpha = max(r * r, 1e-4);
     vec3 n = vec3(0.0, 0.0, 1.0);
     vec3 v = vec3(sqrt(1.0 - n_dot_v * n_dot_v), 0.0, n_dot_v);

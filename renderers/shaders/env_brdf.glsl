@@ -20,4 +20,8 @@ hvec2 env_brdf_approx(hfloat roughness, hfloat n_dot_v) {
     hfloat a004 = min(r.x * r.x, hfloat(exp2(-9.28 * float(n_dot_v)))) * r.x + r.y;
     return hvec2(-1.04, 1.04) * a004 + r.zw;
 }
+// Texture coordinate of (n·v, r) in the DFG LUT, whose texel i holds i/(size − 1) (dfg_lut.comp).
+vec2 dfg_lut_uv(float n_dot_v, float roughness, float size) {
+    return (vec2(n_dot_v, roughness) * (size - 1.0) + 0.5) / size;
+}
 #endif

@@ -75,7 +75,7 @@ vec4 shade_ray(vec2 p) {
     hvec3 spec_light = hvec3(decode_storage(textureLod(prefiltered, dir, lod)));
 
 #if ENV_BRDF == 1
-    hvec2 ab = hvec2(textureLod(dfg_lut, vec2(float(n_dot_v), roughness), 0.0).rg);
+    hvec2 ab = hvec2(textureLod(dfg_lut, dfg_lut_uv(float(n_dot_v), roughness, float(textureSize(dfg_lut, 0).x)), 0.0).rg);
 #else
     hvec2 ab = env_brdf_approx(hr, n_dot_v);
 #endif

@@ -377,7 +377,7 @@ Image Context::create_image(VkFormat format, uint32_t width, uint32_t height, ui
     vci.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, mips, 0, img.layers};
     check(vkCreateImageView(device_, &vci, nullptr, &img.sampled_view), "vkCreateImageView");
     for (uint32_t m = 0; m < mips; ++m) {
-        vci.viewType = VK_IMAGE_VIEW_TYPE_2D_ARRAY;
+        vci.viewType = cube ? VK_IMAGE_VIEW_TYPE_2D_ARRAY : VK_IMAGE_VIEW_TYPE_2D;
         vci.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, m, 1, 0, img.layers};
         VkImageView v;
         check(vkCreateImageView(device_, &vci, nullptr, &v), "vkCreateImageView");
@@ -478,6 +478,61 @@ void Context::copy_buffer_to_image(VkCommandBuffer cmd, const Buffer& src, const
     r.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, mip, 0, dst.layers};
     r.imageExtent = {std::max(1u, dst.width >> mip), std::max(1u, dst.height >> mip), 1};
     vkCmdCopyBufferToImage(cmd, src.buffer, dst.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &r);
+}
+
+namespace {
+float half_to_float(uint16_t h) {
+    uint32_t sign = uint32_t(h >> 15) << 31, exp = (h >> 10) & 0x1f, mant = h & 0x3ff, bits;
+    if (exp == 0) {
+        if (mant == 0) bits = sign;
+        else {  // subnormal
+            int e = -1;
+            do { ++e; mant <<= 1; } while (!(mant & 0x400));
+            bits = sign | uint32_t(127 - 15 - e) << 23 | (mant & 0x3ff) << 13;
+        }
+    } else if (exp == 31) {
+        bits = sign | 0x7f800000u | mant << 13;
+    } else {
+        bits = sign | (exp + 112) << 23 | mant << 13;
+    }
+    float f;
+    std::memcpy(&f, &bits, 4);
+    return f;
+}
+} // namespace
+
+std::vector<float> Context::download(const Image& img, uint32_t mip) {
+    uint32_t w = std::max(1u, img.width >> mip), h = std::max(1u, img.height >> mip);
+    size_t texels = size_t(w) * h * img.layers;
+    size_t bpp = img.format == VK_FORMAT_R32G32B32A32_SFLOAT ? 16 : img.format == VK_FORMAT_R16G16B16A16_SFLOAT ? 8
+               : img.format == VK_FORMAT_R16G16_SFLOAT ? 4 : 0;
+    if (!bpp) throw Error("Context::download: unsupported image format");
+    Buffer buf = create_buffer(texels * bpp, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+    submit([&](VkCommandBuffer cmd) {
+        barrier(cmd);
+        VkBufferImageCopy r{};
+        r.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, mip, 0, img.layers};
+        r.imageExtent = {w, h, 1};
+        vkCmdCopyImageToBuffer(cmd, img.image, VK_IMAGE_LAYOUT_GENERAL, buf.buffer, 1, &r);
+        barrier(cmd);
+    });
+    std::vector<float> out(texels * 4);
+    if (bpp == 16) {
+        std::memcpy(out.data(), buf.mapped, texels * 16);
+    } else {
+        const uint16_t* hp = static_cast<const uint16_t*>(buf.mapped);
+        for (size_t i = 0; i < texels; ++i) {
+            if (bpp == 8)
+                for (int c = 0; c < 4; ++c) out[4 * i + c] = half_to_float(hp[4 * i + c]);
+            else {
+                out[4 * i] = half_to_float(hp[2 * i]);
+                out[4 * i + 1] = half_to_float(hp[2 * i + 1]);
+                out[4 * i + 2] = 0;
+                out[4 * i + 3] = 1;
+            }
+        }
+    }
+    return out;
 }
 
 ComputePipeline::ComputePipeline(Context& ctx, const CompiledShader& shader,

@@ -66,7 +66,7 @@ struct Image {
     uint32_t width = 0, height = 0, mips = 1, layers = 1;
     bool cube = false;
     VkImageView sampled_view = VK_NULL_HANDLE;          // whole image (cube or 2D)
-    std::vector<VkImageView> storage_views;             // one 2D-array view per mip
+    std::vector<VkImageView> storage_views;             // per mip: 2D-array view (cube) or 2D view
     Image() = default;
     Image(const Image&) = delete;
     Image& operator=(const Image&) = delete;
@@ -178,6 +178,9 @@ class Context {
     static void barrier(VkCommandBuffer cmd);
     static void transition(VkCommandBuffer cmd, const Image& img, VkImageLayout from, VkImageLayout to);
     void copy_buffer_to_image(VkCommandBuffer cmd, const Buffer& src, const Image& dst, uint32_t mip = 0);
+    // Reads one mip of an image (all layers) back as RGBA float, layer-major then row-major.
+    // Supports RGBA32F, RGBA16F and RG16F (as R, G, 0, 1) images in the GENERAL layout (tests, debugging).
+    std::vector<float> download(const Image& img, uint32_t mip);
 
     // Debug-utils callback entry (public for the C callback).
     void on_validation_message(int severity, const char* message);
