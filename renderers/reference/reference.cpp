@@ -426,7 +426,10 @@ RenderResult render_reference(const TestSpec& spec, const Environment& env) {
 }
 
 double relative_rmse(const cv::Mat& a, const cv::Mat& b, const cv::Mat& coverage, double* mean_value) {
-    double se = 0, sum = 0;
+    // Per-pixel relative error (relMSE, Rousselle et al. 2011): each squared difference is divided by
+    // the squared local value, so a pixel that straddles the 1e5 sun's reflection weighs no more than
+    // a dim one. The 1e-2 keeps black pixels from dividing by zero.
+    double rel = 0, sum = 0;
     long n = 0;
     for (int y = 0; y < a.rows; ++y)
         for (int x = 0; x < a.cols; ++x) {
@@ -434,16 +437,15 @@ double relative_rmse(const cv::Mat& a, const cv::Mat& b, const cv::Mat& coverage
             const auto& pa = a.at<cv::Vec3f>(y, x);
             const auto& pb = b.at<cv::Vec3f>(y, x);
             for (int c = 0; c < 3; ++c) {
-                double d = double(pa[c]) - pb[c];
-                se += d * d;
-                sum += 0.5 * (double(pa[c]) + pb[c]);
+                double d = double(pa[c]) - pb[c], m = 0.5 * (double(pa[c]) + pb[c]);
+                rel += d * d / (m * m + 1e-2);
+                sum += m;
             }
             ++n;
         }
     if (n == 0) return 0;
-    double mean = sum / (3.0 * n);
-    if (mean_value) *mean_value = mean;
-    return mean > 0 ? std::sqrt(se / (3.0 * n)) / mean : 0;
+    if (mean_value) *mean_value = sum / (3.0 * n);
+    return std::sqrt(rel / (3.0 * n));
 }
 
 NoiseFloor measure_noise_floor(const TestSpec& spec_in, int spp) {

@@ -65,7 +65,8 @@ ReferenceRender render_reference_full(const TestSpec& spec, const Environment* e
 
 // Noise floor of the reference at `spp`: two renders with independent seeds (seed and seed + 1 where
 // seed is the spec's, default 0), compared over covered pixels (coverage > 0):
-//   relative_rmse = sqrt(mean over covered pixels and channels of (a − b)²) / mean over the same of (a + b)/2.
+//   relative_rmse = sqrt(mean over covered pixels and channels of (a − b)² / (m² + 0.01)), m = (a + b)/2
+//   (per-pixel relative error, Rousselle et al. 2011: the sun's few edge pixels do not dominate it).
 // This is the between-seeds figure; each render's own RMS error against the true image is ≈ it / √2.
 // mean_flip: hook for the FLIP metric (metrics/); not filled in here (the metrics library is not a
 // dependency of the reference), callers holding both images may compute it.

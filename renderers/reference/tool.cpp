@@ -11,6 +11,7 @@
 #include <fstream>
 #include <iostream>
 
+#include "metrics/flip.h"
 #include "renderers/reference/reference.h"
 
 using namespace iblcheck;
@@ -64,12 +65,12 @@ int main(int argc, char** argv) {
             NoiseFloor nf = measure_noise_floor(spec, spp);
             image = nf.image_a;
             meta["noise_floor"] = {{"relative_rmse", nf.relative_rmse},
-                                   {"definition", "sqrt(mean((a-b)^2)) / mean((a+b)/2) over covered pixels and "
-                                                  "channels, a/b = renders with seeds a/b"},
+                                   {"definition", "sqrt(mean((a-b)^2 / (m^2 + 0.01))), m = (a+b)/2, over covered "
+                                                  "pixels and channels; a/b = renders with seeds a/b"},
                                    {"mean_value", nf.mean_value},
                                    {"covered_pixels", nf.covered_pixels},
                                    {"seeds", {nf.seed_a, nf.seed_b}},
-                                   {"mean_flip", nullptr}};
+                                   {"mean_flip", compute_flip_hdr(nf.image_a, nf.image_b, FlipOptions{}).mean}};
             meta["seeds"] = {nf.seed_a, nf.seed_b};
             meta["provenance"] = nf.provenance_a;
         } else {
