@@ -11,4 +11,8 @@ void register_render_command(CLI::App& app, int& exit_code);
 void register_run_commands(CLI::App& app, int& exit_code); // run, bless, bisect
 void register_report_command(CLI::App& app, int& exit_code);
 
+// The command line as typed, recorded in results JSON.
+void set_invocation(const std::string& command_line);
+const std::string& invocation();
+
 } // namespace iblcheck::cli

@@ -1,0 +1,96 @@
+// `iblcheck run`, `iblcheck bless`, `iblcheck bisect`.
+#include <fmt/core.h>
+
+#include "commands.h"
+#include "harness/common/errors.h"
+#include "harness/runner.h"
+
+namespace iblcheck::cli {
+
+namespace {
+void parse_shard(const std::string& s, int& index, int& count) {
+    if (s.empty()) return;
+    if (std::sscanf(s.c_str(), "%d/%d", &index, &count) != 2)
+        throw UsageError("--shard '" + s + "' is not INDEX/COUNT (0-based index)");
+}
+} // namespace
+
+void register_run_commands(CLI::App& app, int& exit_code) {
+    static RunOptions run;
+    static std::string shard, out, junit, json_out, history, goldens;
+    auto* r = app.add_subcommand("run", "Run a suite: render, compare with goldens, verdicts, report");
+    r->add_option("--suite", run.suite, "Suite name (harness/suites) or a .json path")->capture_default_str();
+    r->add_option("--filter", run.filter, "Glob on test names");
+    r->add_option("--shard", shard, "INDEX/COUNT: run one shard (GTest convention, 0-based)");
+    r->add_option("--jobs,-j", run.jobs, "Tests in parallel (default: the suite's)");
+    r->add_option("--out", out, "Folder for results.json, images and index.html");
+    r->add_option("--junit", junit, "JUnit XML file");
+    r->add_option("--json", json_out, "Results JSON file");
+    r->add_option("--history", history, "Append this run to a history file (JSON lines) and chart it");
+    r->add_option("--goldens", goldens, "Golden folder (default: goldens/)");
+    r->add_option("--device", run.device, "Vulkan device/driver name substring (default: lavapipe)");
+    r->add_flag("--quiet,-q", run.quiet, "No per-test lines");
+    r->callback([&exit_code] {
+        parse_shard(shard, run.shard_index, run.shard_count);
+        if (const char* gi = std::getenv("GTEST_SHARD_INDEX"); gi && shard.empty()) run.shard_index = std::atoi(gi);
+        if (const char* gt = std::getenv("GTEST_TOTAL_SHARDS"); gt && shard.empty()) run.shard_count = std::atoi(gt);
+        run.out_dir = out;
+        run.junit = junit;
+        run.json = json_out;
+        run.history = history;
+        run.goldens = goldens;
+        run.command_line = invocation();
+        exit_code = run_suite(run).exit_code();
+    });
+
+    static BlessOptions bo;
+    static std::string bless_goldens;
+    auto* b = app.add_subcommand("bless", "Re-render and write baseline goldens (the only writer of goldens)");
+    b->add_option("--suite", bo.suite, "Suite name or path")->capture_default_str();
+    b->add_option("--filter", bo.filter, "Glob on test names (default: every test of the suite)");
+    b->add_option("--label", bo.label, "Write an alternate approved baseline <test>@LABEL (e.g. a platform)");
+    b->add_option("--goldens", bless_goldens, "Golden folder (default: goldens/)");
+    b->add_option("--device", bo.device, "Vulkan device/driver name substring");
+    b->add_flag("--dry-run", bo.dry_run, "Show what would change, write nothing");
+    b->callback([&exit_code] {
+        bo.goldens = bless_goldens;
+        exit_code = bless(bo);
+    });
+
+    static RunOptions bis;
+    static std::string bis_goldens;
+    auto* s = app.add_subcommand("bisect",
+                                 "git bisect run contract: exit 0 good, 1 bad, 125 cannot test (shader compile failure)");
+    s->add_option("--suite", bis.suite, "Suite name or path")->capture_default_str();
+    s->add_option("--filter", bis.filter, "Glob on test names (required: keep it to the failing tests)")->required();
+    s->add_option("--goldens", bis_goldens, "Golden folder to judge against (copy the good goldens out of the tree)");
+    s->add_option("--device", bis.device, "Vulkan device/driver name substring");
+    s->callback([&exit_code] {
+        bis.goldens = bis_goldens;
+        bis.report = false;
+        RunSummary sum;
+        try {
+            sum = run_suite(bis);
+        } catch (const ShaderCompileError& e) {
+            fmt::print(stderr, "cannot test: {}\n", e.what());
+            exit_code = kExitCannotTest;
+            return;
+        } catch (const EnvironmentError& e) {
+            fmt::print(stderr, "cannot test: {}\n", e.what());
+            exit_code = kExitCannotTest;
+            return;
+        }
+        if (sum.shader_compile_error) exit_code = kExitCannotTest;
+        else if (sum.error) exit_code = kExitCannotTest;
+        else exit_code = (sum.fail || sum.missing) ? 1 : 0;
+        fmt::print("bisect verdict: {}\n", exit_code == 0 ? "good" : exit_code == 1 ? "bad" : "skip (125)");
+    });
+}
+
+namespace {
+std::string g_invocation = "iblcheck";
+}
+void set_invocation(const std::string& command_line) { g_invocation = command_line; }
+const std::string& invocation() { return g_invocation; }
+
+} // namespace iblcheck::cli

@@ -1,0 +1,159 @@
+#include "golden_store.h"
+
+#include <array>
+#include <chrono>
+#include <cstdio>
+#include <ctime>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "harness/common/errors.h"
+#include "metrics/image_io.h"
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace iblcheck {
+
+namespace {
+std::string run_capture(const std::string& cmd) {
+    std::string out;
+    FILE* p = popen(cmd.c_str(), "r");
+    if (!p) return out;
+    std::array<char, 256> buf;
+    while (fgets(buf.data(), buf.size(), p)) out += buf.data();
+    pclose(p);
+    while (!out.empty() && (out.back() == '\n' || out.back() == ' ')) out.pop_back();
+    return out;
+}
+
+Golden load_golden(const fs::path& exr, const std::string& label) {
+    Golden g;
+    g.image_path = exr;
+    g.label = label;
+    g.image = read_image(exr.string()).pixels;
+    fs::path side = fs::path(exr).replace_extension(".json");
+    if (fs::exists(side)) {
+        try {
+            std::ifstream f(side);
+            g.provenance = json::parse(f);
+        } catch (const json::parse_error& e) {
+            throw InputError(side.string() + ": corrupt golden sidecar: " + e.what());
+        }
+    }
+    return g;
+}
+} // namespace
+
+std::string safe_file_name(const std::string& name) {
+    std::string s = name;
+    for (char& ch : s)
+        if (ch == '/' || ch == ':' || ch == '\\' || ch == ' ' || ch == '*' || ch == '?') ch = '-';
+    return s;
+}
+
+std::string reference_key(const TestSpec& spec) {
+    std::string key = spec.scene + "__" + safe_file_name(spec.env);
+    static const std::set<std::string> material = {"roughness", "metallic", "base_color", "env_rotation"};
+    std::string extra;
+    for (auto& [k, v] : spec.options.values())
+        if (material.count(k)) extra += (extra.empty() ? "" : ",") + k + "=" + v;
+    if (!extra.empty()) key += "__" + safe_file_name(extra);
+    if (spec.width > 0) key += "__" + std::to_string(spec.width) + "x" + std::to_string(spec.height);
+    return key;
+}
+
+GoldenStore::GoldenStore(fs::path root) {
+    if (root.empty()) {
+        if (const char* e = std::getenv("IBLCHECK_GOLDEN_DIR"); e && *e) root = e;
+        else root = fs::path(IBLCHECK_SOURCE_DIR) / "goldens";
+    }
+    root_ = root;
+}
+
+fs::path GoldenStore::baseline_path(const std::string& test_name, const std::string& label) const {
+    return root_ / "baseline" / (safe_file_name(test_name) + (label.empty() ? "" : "@" + label) + ".exr");
+}
+
+fs::path GoldenStore::reference_path(const TestSpec& spec) const {
+    return root_ / "reference" / (reference_key(spec) + ".exr");
+}
+
+std::vector<Golden> GoldenStore::baselines(const std::string& test_name) const {
+    std::vector<Golden> out;
+    fs::path primary = baseline_path(test_name);
+    if (fs::exists(primary)) out.push_back(load_golden(primary, ""));
+    fs::path dir = root_ / "baseline";
+    std::string prefix = safe_file_name(test_name) + "@";
+    if (fs::is_directory(dir)) {
+        std::vector<fs::path> alts;
+        for (auto& e : fs::directory_iterator(dir)) {
+            std::string f = e.path().filename().string();
+            if (e.path().extension() == ".exr" && f.rfind(prefix, 0) == 0) alts.push_back(e.path());
+        }
+        std::sort(alts.begin(), alts.end());
+        for (auto& p : alts) {
+            std::string stem = p.stem().string();
+            out.push_back(load_golden(p, stem.substr(prefix.size())));
+        }
+    }
+    return out;
+}
+
+std::optional<Golden> GoldenStore::reference(const TestSpec& spec) const {
+    fs::path p = reference_path(spec);
+    if (!fs::exists(p)) return std::nullopt;
+    return load_golden(p, "");
+}
+
+void GoldenStore::write_golden(const fs::path& exr, const cv::Mat& image, const json& provenance) {
+    fs::create_directories(exr.parent_path());
+    std::string tag = ".tmp" + std::to_string(::getpid());
+    fs::path tmp_exr = exr;
+    tmp_exr += tag + ".exr";
+    fs::path side = fs::path(exr).replace_extension(".json");
+    fs::path tmp_side = side;
+    tmp_side += tag;
+    write_exr(tmp_exr.string(), image);
+    {
+        std::ofstream f(tmp_side);
+        f << provenance.dump(2) << "\n";
+        if (!f) throw InputError(tmp_side.string() + ": cannot write golden sidecar");
+    }
+    fs::rename(tmp_exr, exr);
+    fs::rename(tmp_side, side);
+}
+
+std::string project_commit(bool* dirty) {
+    std::string dir = IBLCHECK_SOURCE_DIR;
+    std::string c = run_capture("git -C '" + dir + "' rev-parse --short=12 HEAD 2>/dev/null");
+    if (dirty)
+        *dirty = !run_capture("git -C '" + dir + "' status --porcelain --untracked-files=no 2>/dev/null").empty();
+    return c.empty() ? "unknown" : c;
+}
+
+std::string utc_now_iso() {
+    std::time_t t = std::time(nullptr);
+    char buf[32];
+    std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&t));
+    return buf;
+}
+
+std::vector<std::string> cpu_features() {
+    std::ifstream f("/proc/cpuinfo");
+    std::string line;
+    std::vector<std::string> out;
+    static const std::set<std::string> wanted = {"sse4_2", "avx", "avx2", "fma", "f16c", "avx512f", "avx512bw", "neon", "asimd"};
+    while (std::getline(f, line)) {
+        if (line.rfind("flags", 0) != 0 && line.rfind("Features", 0) != 0) continue;
+        std::istringstream ss(line.substr(line.find(':') + 1));
+        std::string w;
+        while (ss >> w)
+            if (wanted.count(w)) out.push_back(w);
+        break;
+    }
+    return out;
+}
+
+} // namespace iblcheck

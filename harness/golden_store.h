@@ -1,0 +1,60 @@
+// The golden store (goldens/): two kinds kept apart.
+//   reference/<key>.exr + .json   ground truth from the reference integrator (accuracy is measured
+//                                  against it); key = <scene>__<env> (see reference_key)
+//   baseline/<test>.exr + .json   the approved output of a tested configuration; alternates
+//                                  baseline/<test>@<label>.exr are further approved outputs (a known
+//                                  platform difference is approved, not hidden by a wider tolerance)
+// Every golden has a JSON sidecar of provenance. Only `iblcheck bless` (and the reference
+// regeneration script) writes goldens, atomically: image and sidecar go to temporary files that are
+// renamed into place, so a reader never sees a half-written golden.
+#pragma once
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "renderers/render_api.h"
+
+namespace iblcheck {
+
+struct Golden {
+    std::filesystem::path image_path;
+    cv::Mat image;               // CV_32FC3 linear
+    nlohmann::json provenance;   // sidecar
+    std::string label;           // "" for the primary baseline, else the @label
+};
+
+class GoldenStore {
+  public:
+    // root: --goldens, else $IBLCHECK_GOLDEN_DIR, else <source>/goldens.
+    explicit GoldenStore(std::filesystem::path root = {});
+    const std::filesystem::path& root() const { return root_; }
+
+    // All approved baselines of a test (primary first). Throws InputError on a corrupt golden.
+    std::vector<Golden> baselines(const std::string& test_name) const;
+    std::optional<Golden> reference(const TestSpec& spec) const;
+    std::filesystem::path baseline_path(const std::string& test_name, const std::string& label = "") const;
+    std::filesystem::path reference_path(const TestSpec& spec) const;
+
+    // Atomically writes image + sidecar.
+    static void write_golden(const std::filesystem::path& exr, const cv::Mat& image, const nlohmann::json& provenance);
+
+  private:
+    std::filesystem::path root_;
+};
+
+// <scene>__<env>: ':' and '/' in the env spec become '-'; material options of single-sphere scenes
+// (roughness, metallic, base_color), a non-default size and env_rotation are appended, since they
+// change the true image.
+std::string reference_key(const TestSpec& spec);
+// File-system-safe form of a test name.
+std::string safe_file_name(const std::string& name);
+
+// Provenance common to every golden and every run: project commit, date, CPU features.
+std::string project_commit(bool* dirty = nullptr);
+std::string utc_now_iso();
+std::vector<std::string> cpu_features();
+
+} // namespace iblcheck

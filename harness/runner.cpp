@@ -1,0 +1,531 @@
+#include "runner.h"
+
+#include <fmt/core.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <mutex>
+#include <thread>
+#include <unistd.h>
+
+#include "harness/common/errors.h"
+#include "metrics/display_transform.h"
+#include "metrics/flip.h"
+#include "metrics/image_io.h"
+#include "metrics/psnr.h"
+#include "metrics/ssim.h"
+#include "renderers/renderer.h"
+#include "renderers/scenes/scene.h"
+
+#ifdef IBLCHECK_HAVE_REPORT
+#include "reports/report_writer.h"
+#endif
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace iblcheck {
+
+namespace {
+
+// Metrics of `test` against `golden` as results JSON (the same keys `iblcheck compare --json` prints).
+json compare_images(const cv::Mat& golden, const cv::Mat& test, int flip_threads, FlipResult* flip_out = nullptr) {
+    FlipOptions fo;
+    fo.threads = flip_threads;
+    FlipResult f = compute_flip_hdr(golden, test, fo);
+    SsimResult s = compute_ssim_hdr(golden, test);
+    PsnrResult p = compute_psnr(display_transform(golden), display_transform(test));
+    json j;
+    j["flip"] = {{"mean", f.mean}, {"weighted_median", f.weighted_median}, {"weighted_q1", f.weighted_q1},
+                 {"weighted_q3", f.weighted_q3}, {"p99", f.p99}, {"min", f.min}, {"max", f.max},
+                 {"block_max", f.block_max}, {"block_x", f.block_x}, {"block_y", f.block_y}, {"mode", f.mode},
+                 {"start_exposure", f.start_exposure}, {"stop_exposure", f.stop_exposure},
+                 {"num_exposures", f.num_exposures}};
+    j["ssim"] = {{"mean", s.mean}};
+    j["psnr"] = {{"db", std::isfinite(p.db) ? json(p.db) : json(999.0)}, {"rmse", p.rmse}, {"max_abs", p.max_abs}};
+    if (flip_out) *flip_out = std::move(f);
+    return j;
+}
+
+double metric_value(const json& metrics, const std::string& key) {
+    auto dot = key.find('.');
+    return metrics.at(key.substr(0, dot)).at(key.substr(dot + 1)).get<double>();
+}
+
+// Larger is better for SSIM and PSNR, smaller for FLIP.
+bool higher_is_better(const std::string& metric) { return metric.rfind("ssim", 0) == 0 || metric.rfind("psnr", 0) == 0; }
+
+std::string fmt_num(double v) { return fmt::format("{:.4g}", v); }
+
+// Pixel → sphere index (−1 for background), from the same camera and intersection the renderers use.
+cv::Mat sphere_id_map(const TestSpec& spec, int width, int height) {
+    Scene scene = build_scene(spec.scene, spec.options);
+    cv::Mat ids(height, width, CV_32S);
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x) {
+            Vec3f o, d;
+            camera_ray(scene, width, height, x + 0.5, y + 0.5, o, d);
+            Hit h = intersect(scene, o, d);
+            ids.at<int>(y, x) = h.hit ? h.sphere : -1;
+        }
+    return ids;
+}
+
+json per_sphere_errors(const TestSpec& spec, const cv::Mat& errmap) {
+    Scene scene = build_scene(spec.scene, spec.options);
+    if (scene.spheres.size() < 2) return json();
+    cv::Mat ids = sphere_id_map(spec, errmap.cols, errmap.rows);
+    std::vector<double> sum(scene.spheres.size(), 0.0);
+    std::vector<long> count(scene.spheres.size(), 0);
+    for (int y = 0; y < errmap.rows; ++y)
+        for (int x = 0; x < errmap.cols; ++x) {
+            int id = ids.at<int>(y, x);
+            if (id < 0) continue;
+            sum[size_t(id)] += errmap.at<float>(y, x);
+            count[size_t(id)]++;
+        }
+    json out = json::array();
+    for (size_t i = 0; i < scene.spheres.size(); ++i) {
+        if (!count[i]) continue;
+        out.push_back({{"label", i < scene.labels.size() ? scene.labels[i] : std::to_string(i)},
+                       {"roughness", scene.spheres[i].material.roughness},
+                       {"metallic", scene.spheres[i].material.metallic},
+                       {"flip_mean", sum[i] / double(count[i])}});
+    }
+    return out;
+}
+
+struct Worker {
+    explicit Worker(const std::string& device) : renderer([&] {
+        vk::ContextOptions o;
+        o.device = device;
+        return o;
+    }()) {}
+    Renderer renderer;
+};
+
+void write_test_png(const fs::path& dir, const std::string& name, const cv::Mat& linear) {
+    fs::create_directories(dir);
+    write_png((dir / name).string(), display_transform(linear));
+}
+
+json timings_json(const RenderResult& r, double& precompute_ms, double& frame_ms) {
+    json t = json::array();
+    precompute_ms = frame_ms = 0;
+    for (auto& p : r.timings) {
+        t.push_back({{"pass", p.name}, {"ms", p.ms}, {"gpu", p.gpu}, {"precompute", p.precompute}});
+        (p.precompute ? precompute_ms : frame_ms) += p.ms;
+    }
+    return t;
+}
+
+// One test: render, compare, decide. Never throws: failures become verdicts.
+json run_test(const TestCase& tc, Worker& w, const GoldenStore& store, const fs::path& out_dir, int flip_threads,
+              bool& shader_error) {
+    json r;
+    r["name"] = tc.name;
+    r["suite"] = tc.suite;
+    r["scene"] = tc.spec.scene;
+    r["method"] = tc.spec.method;
+    r["env"] = tc.spec.env;
+    r["options"] = tc.spec.options.values();
+    r["variant"] = tc.variant;
+    r["tags"] = tc.tags;
+    r["bless_command"] = bless_command(tc);
+    r["comparisons"] = json::array();
+    r["accuracy"] = nullptr;
+    r["driver_mismatch"] = nullptr;
+    fs::path img_dir = out_dir.empty() ? fs::path() : out_dir / "images" / safe_file_name(tc.name);
+    auto rel = [&](const std::string& f) { return ("images/" + safe_file_name(tc.name) + "/" + f); };
+    auto t0 = std::chrono::steady_clock::now();
+    try {
+        RenderResult rr = w.renderer.render(tc.spec);
+        r["width"] = rr.image.cols;
+        r["height"] = rr.image.rows;
+        double pre = 0, frame = 0;
+        r["timings"] = timings_json(rr, pre, frame);
+        r["precompute_ms"] = pre;
+        r["frame_ms"] = frame;
+        r["texture_fetches_per_pixel"] = rr.texture_fetches_per_pixel;
+        r["provenance"] = rr.provenance;
+        check_finite(rr.image, tc.name + " (render)");
+        if (!img_dir.empty()) write_test_png(img_dir, "test.png", rr.image);
+
+        std::vector<std::string> problems;
+        bool any_fail = false, improved = false, missing = false;
+        const std::string driver_now = rr.provenance.value("driver", json::object()).value("driver_info", "");
+
+        // 1. Approved baselines: pass against any of them.
+        json approved_accuracy;
+        if (tc.baseline) {
+            auto goldens = store.baselines(tc.name);
+            if (goldens.empty()) {
+                missing = true;
+                problems.push_back("no baseline golden at " + store.baseline_path(tc.name).string() + "; create it with: " +
+                                   bless_command(tc));
+            }
+            json best;
+            bool passed_one = false;
+            for (auto& g : goldens) {
+                json c;
+                c["kind"] = "baseline";
+                c["golden"] = g.image_path.string();
+                c["label"] = g.label;
+                if (g.image.size() != rr.image.size()) {
+                    c["verdict"] = "fail";
+                    c["checks"] = json::array({{{"metric", "size"}, {"status", "fail"},
+                                                {"value", fmt::format("{}x{}", rr.image.cols, rr.image.rows)},
+                                                {"expected", fmt::format("{}x{}", g.image.cols, g.image.rows)}}});
+                    if (best.is_null()) best = c;
+                    continue;
+                }
+                FlipResult flip;
+                c["metrics"] = compare_images(g.image, rr.image, flip_threads, &flip);
+                c["checks"] = json::array();
+                bool ok = true;
+                std::string why;
+                for (auto& [metric, bound] : tc.baseline_tolerances) {
+                    double v = metric_value(c["metrics"], metric);
+                    std::string status = "pass";
+                    if (bound.max && v > *bound.max) {
+                        status = "fail";
+                        why += fmt::format("{} {} > {} (+{}); ", metric, fmt_num(v), fmt_num(*bound.max), fmt_num(v - *bound.max));
+                    }
+                    if (bound.min && v < *bound.min) {
+                        status = "fail";
+                        why += fmt::format("{} {} < {} (-{}); ", metric, fmt_num(v), fmt_num(*bound.min), fmt_num(*bound.min - v));
+                    }
+                    ok &= status == "pass";
+                    c["checks"].push_back({{"metric", metric}, {"value", v},
+                                           {"min", bound.min ? json(*bound.min) : json()},
+                                           {"max", bound.max ? json(*bound.max) : json()}, {"status", status}});
+                }
+                c["verdict"] = ok ? "pass" : "fail";
+                if (!ok) c["message"] = why + fmt::format("worst 16x16 block at ({},{}) with mean FLIP {}", flip.block_x,
+                                                          flip.block_y, fmt_num(flip.block_max));
+                std::string golden_driver = g.provenance.value("driver", json::object()).value("driver_info", "");
+                if (!golden_driver.empty() && !driver_now.empty() && golden_driver != driver_now)
+                    r["driver_mismatch"] = "golden made with " + golden_driver + ", this run " + driver_now;
+                if (!img_dir.empty()) {
+                    std::string tag = g.label.empty() ? "baseline" : "baseline@" + safe_file_name(g.label);
+                    write_test_png(img_dir, tag + ".png", g.image);
+                    write_png((img_dir / (tag + "_flip.png")).string(), magma_heatmap(flip.errmap));
+                    c["images"] = {{"test", rel("test.png")}, {"golden", rel(tag + ".png")}, {"heatmap", rel(tag + "_flip.png")}};
+                }
+                if (ok && !passed_one) {
+                    passed_one = true;
+                    best = c;
+                    approved_accuracy = g.provenance.value("accuracy", json());
+                } else if (!passed_one && (best.is_null() || !best.contains("metrics") ||
+                                           c["metrics"]["flip"]["mean"].get<double>() < best["metrics"]["flip"]["mean"].get<double>())) {
+                    best = c;
+                }
+            }
+            if (!goldens.empty()) {
+                r["comparisons"].push_back(best);
+                if (!passed_one) {
+                    any_fail = true;
+                    problems.push_back("baseline: " + best.value("message", std::string("size differs")));
+                }
+            }
+        }
+
+        // 2. Accuracy against the reference golden, checked against the band approved at bless time.
+        if (tc.reference) {
+            if (auto ref = store.reference(tc.spec)) {
+                json c;
+                c["kind"] = "reference";
+                c["golden"] = ref->image_path.string();
+                if (ref->image.size() != rr.image.size()) {
+                    c["verdict"] = "fail";
+                    problems.push_back("reference golden " + ref->image_path.string() + " has another size");
+                    any_fail = true;
+                } else {
+                    FlipResult flip;
+                    c["metrics"] = compare_images(ref->image, rr.image, flip_threads, &flip);
+                    r["accuracy"] = {{"flip_mean", flip.mean}, {"ssim", c["metrics"]["ssim"]["mean"]},
+                                     {"golden", ref->image_path.string()},
+                                     {"noise_floor", ref->provenance.value("noise_floor", json())}};
+                    json ps = per_sphere_errors(tc.spec, flip.errmap);
+                    if (!ps.is_null()) r["per_sphere"] = ps;
+                    c["checks"] = json::array();
+                    std::string verdict = "pass";
+                    for (auto& [metric, band] : tc.reference_band) {
+                        if (!approved_accuracy.is_object() || !approved_accuracy.contains(metric)) continue;
+                        double approved = approved_accuracy[metric].get<double>();
+                        double v = metric_value(c["metrics"], metric);
+                        bool hib = higher_is_better(metric);
+                        double lo = approved * (1 - band.below) - band.abs, hi = approved * (1 + band.above) + band.abs;
+                        std::string status = "pass";
+                        if (v > hi) status = hib ? "improved" : "fail";
+                        if (v < lo) status = hib ? "fail" : "improved";
+                        if (status == "fail") {
+                            any_fail = true;
+                            problems.push_back(fmt::format("accuracy: {} {} outside [{}, {}] approved around {}; worst block at ({},{})",
+                                                           metric, fmt_num(v), fmt_num(lo), fmt_num(hi), fmt_num(approved),
+                                                           flip.block_x, flip.block_y));
+                            verdict = "fail";
+                        } else if (status == "improved") {
+                            improved = true;
+                            problems.push_back(fmt::format("accuracy improved: {} {} beyond [{}, {}]: tighten by re-blessing",
+                                                           metric, fmt_num(v), fmt_num(lo), fmt_num(hi)));
+                            if (verdict == "pass") verdict = "improved";
+                        }
+                        c["checks"].push_back({{"metric", metric}, {"value", v}, {"min", lo}, {"max", hi}, {"status", status},
+                                               {"approved", approved}});
+                    }
+                    c["verdict"] = verdict;
+                    if (!img_dir.empty()) {
+                        write_test_png(img_dir, "reference.png", ref->image);
+                        write_png((img_dir / "reference_flip.png").string(), magma_heatmap(flip.errmap));
+                        c["images"] = {{"test", rel("test.png")}, {"golden", rel("reference.png")}, {"heatmap", rel("reference_flip.png")}};
+                    }
+                }
+                r["comparisons"].push_back(c);
+            }
+        }
+
+        std::string verdict = missing ? "missing-golden" : any_fail ? "fail" : improved ? "improved" : "pass";
+        r["verdict"] = verdict;
+        std::string msg;
+        for (auto& p : problems) msg += (msg.empty() ? "" : "; ") + p;
+        r["message"] = msg;
+        if (verdict != "pass" && !img_dir.empty()) write_exr((img_dir / "test.exr").string(), rr.image);
+    } catch (const ShaderCompileError& e) {
+        shader_error = true;
+        r["verdict"] = "error";
+        r["message"] = std::string("shader compile failed: ") + e.what();
+    } catch (const std::exception& e) {
+        r["verdict"] = "error";
+        r["message"] = e.what();
+    }
+    r["wall_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return r;
+}
+
+std::string xml_escape(const std::string& s) {
+    std::string o;
+    for (char c : s) {
+        switch (c) {
+        case '&': o += "&amp;"; break;
+        case '<': o += "&lt;"; break;
+        case '>': o += "&gt;"; break;
+        case '"': o += "&quot;"; break;
+        case '\'': o += "&apos;"; break;
+        default:
+            if (static_cast<unsigned char>(c) < 0x20 && c != '\n' && c != '\t') o += ' ';
+            else o += c;
+        }
+    }
+    return o;
+}
+
+} // namespace
+
+std::string bless_command(const TestCase& t) {
+    return "iblcheck bless --suite " + t.suite + " --filter '" + t.name + "'";
+}
+
+int RunSummary::exit_code() const {
+    if (error) return kExitError;
+    if (fail || missing) return kExitRegression;
+    return kExitPass;
+}
+
+void write_junit(const json& results, const fs::path& file) {
+    const json& tests = results.at("tests");
+    int failures = 0, errors = 0;
+    for (auto& t : tests) {
+        std::string v = t.value("verdict", "error");
+        failures += v == "fail" || v == "missing-golden";
+        errors += v == "error";
+    }
+    std::string suite = results.value("suite", "iblcheck");
+    std::string x = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
+    x += fmt::format("<testsuites name=\"iblcheck\" tests=\"{}\" failures=\"{}\" errors=\"{}\" time=\"{:.3f}\">\n",
+                     tests.size(), failures, errors, results.value("total_s", 0.0));
+    x += fmt::format("  <testsuite name=\"{}\" tests=\"{}\" failures=\"{}\" errors=\"{}\" skipped=\"0\" time=\"{:.3f}\" timestamp=\"{}\">\n",
+                     xml_escape(suite), tests.size(), failures, errors, results.value("total_s", 0.0),
+                     xml_escape(results.value("started", "")));
+    for (auto& t : tests) {
+        std::string name = t.value("name", "?"), v = t.value("verdict", "error"), msg = t.value("message", "");
+        x += fmt::format("    <testcase classname=\"{}.{}\" name=\"{}\" time=\"{:.3f}\">", xml_escape(suite),
+                         xml_escape(t.value("method", "")), xml_escape(name), t.value("wall_s", 0.0));
+        if (v == "fail" || v == "missing-golden")
+            x += fmt::format("\n      <failure type=\"{}\" message=\"{}\">{}\nrebless: {}</failure>\n    ", v, xml_escape(msg),
+                             xml_escape(msg), xml_escape(t.value("bless_command", "")));
+        else if (v == "error")
+            x += fmt::format("\n      <error type=\"error\" message=\"{}\">{}</error>\n    ", xml_escape(msg), xml_escape(msg));
+        else if (v == "improved")
+            x += fmt::format("\n      <system-out>improved: {}</system-out>\n    ", xml_escape(msg));
+        x += "</testcase>\n";
+    }
+    x += "  </testsuite>\n</testsuites>\n";
+    if (!file.parent_path().empty()) fs::create_directories(file.parent_path());
+    std::ofstream f(file);
+    f << x;
+    if (!f) throw InputError(file.string() + ": cannot write JUnit XML");
+}
+
+RunSummary run_suite(const RunOptions& o) {
+    Suite suite = load_suite(o.suite);
+    std::vector<TestCase> tests = select_tests(suite, o.filter, o.shard_index, o.shard_count);
+    if (tests.empty()) throw UsageError("no test in suite " + suite.name + " matches --filter '" + o.filter + "'");
+    GoldenStore store(o.goldens);
+    int jobs = o.jobs > 0 ? o.jobs : suite.jobs;
+    jobs = std::max(1, std::min<int>(jobs, int(tests.size())));
+    int flip_threads = jobs > 1 ? 1 : 0;
+    if (!o.out_dir.empty()) fs::create_directories(o.out_dir);
+
+    auto t0 = std::chrono::steady_clock::now();
+    std::vector<json> results(tests.size());
+    std::atomic<size_t> next{0};
+    std::atomic<int> done{0};
+    std::atomic<bool> shader_error{false};
+    std::mutex print_mutex;
+    json driver;
+    std::mutex driver_mutex;
+    bool interactive = isatty(STDOUT_FILENO);
+    auto work = [&] {
+        Worker w(o.device);
+        for (size_t i; (i = next++) < tests.size();) {
+            bool se = false;
+            results[i] = run_test(tests[i], w, store, o.out_dir, flip_threads, se);
+            if (se) shader_error = true;
+            int n = ++done;
+            if (!o.quiet) {
+                std::lock_guard lock(print_mutex);
+                const json& r = results[i];
+                std::string acc = r["accuracy"].is_object() ? fmt::format("  vs truth {:.4f}", r["accuracy"]["flip_mean"].get<double>()) : "";
+                fmt::print("{}[{:>3}/{}] {:<15} {}{}  ({:.1f} s)\n", interactive ? "\r" : "", n, tests.size(),
+                           r["verdict"].get<std::string>(), r["name"].get<std::string>(), acc, r["wall_s"].get<double>());
+                if (r["verdict"] != "pass" && !r["message"].get<std::string>().empty())
+                    fmt::print("          {}\n", r["message"].get<std::string>());
+                std::fflush(stdout);
+            }
+        }
+        std::lock_guard lock(driver_mutex);
+        json d = w.renderer.driver_json();
+        if (!d.empty()) driver = d;
+    };
+    std::vector<std::thread> pool;
+    for (int j = 0; j < jobs; ++j) pool.emplace_back(work);
+    for (auto& t : pool) t.join();
+
+    RunSummary s;
+    bool dirty = false;
+    json& R = s.results;
+    R["schema"] = "iblcheck-results/1";
+    R["suite"] = suite.name;
+    R["command"] = o.command_line;
+    R["started"] = utc_now_iso();
+    R["total_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    R["commit"] = project_commit(&dirty);
+    R["dirty"] = dirty;
+    R["driver"] = driver;
+    R["cpu_features"] = cpu_features();
+    R["shard"] = fmt::format("{}/{}", o.shard_index, o.shard_count);
+    R["tests"] = json::array();
+    for (auto& r : results) {
+        std::string v = r["verdict"];
+        s.pass += v == "pass";
+        s.fail += v == "fail";
+        s.improved += v == "improved";
+        s.missing += v == "missing-golden";
+        s.error += v == "error";
+        R["tests"].push_back(r);
+    }
+    R["counts"] = {{"pass", s.pass}, {"fail", s.fail}, {"improved", s.improved}, {"missing-golden", s.missing}, {"error", s.error}};
+    s.shader_compile_error = shader_error;
+
+    if (!o.out_dir.empty()) {
+        std::ofstream f(o.out_dir / "results.json");
+        f << R.dump(1) << "\n";
+    }
+    if (!o.json.empty()) {
+        std::ofstream f(o.json);
+        f << R.dump(1) << "\n";
+        if (!f) throw InputError(o.json.string() + ": cannot write results JSON");
+    }
+    if (!o.junit.empty()) write_junit(R, o.junit);
+#ifdef IBLCHECK_HAVE_REPORT
+    std::vector<json> history;
+    if (!o.history.empty()) {
+        append_history(o.history, history_entry(R));
+        history = read_history(o.history);
+    }
+    if (!o.out_dir.empty() && o.report) write_report(R, o.out_dir, o.out_dir, history);
+#endif
+    if (!o.quiet)
+        fmt::print("{} tests: {} pass, {} fail, {} improved, {} missing-golden, {} error  ({:.1f} s){}\n", tests.size(), s.pass,
+                   s.fail, s.improved, s.missing, s.error, R["total_s"].get<double>(),
+                   o.out_dir.empty() ? "" : "  report: " + (o.out_dir / "index.html").string());
+    return s;
+}
+
+int bless(const BlessOptions& o) {
+    Suite suite = load_suite(o.suite);
+    std::vector<TestCase> tests = select_tests(suite, o.filter, 0, 1);
+    if (tests.empty()) throw UsageError("no test in suite " + suite.name + " matches --filter '" + o.filter + "'");
+    GoldenStore store(o.goldens);
+    Worker w(o.device);
+    int failed = 0;
+    bool dirty = false;
+    std::string commit = project_commit(&dirty);
+    for (const auto& tc : tests) {
+        if (!tc.baseline) continue;
+        RenderResult rr;
+        try {
+            rr = w.renderer.render(tc.spec);
+            check_finite(rr.image, tc.name + " (render)");
+        } catch (const std::exception& e) {
+            fmt::print(stderr, "error: {}: render failed, not blessed: {}\n", tc.name, e.what());
+            ++failed;
+            continue;
+        }
+        json accuracy = json::object();
+        if (auto ref = store.reference(tc.spec); ref && ref->image.size() == rr.image.size()) {
+            json m = compare_images(ref->image, rr.image, 0);
+            accuracy = {{"flip.mean", m["flip"]["mean"]}, {"flip.p99", m["flip"]["p99"]}, {"flip.block_max", m["flip"]["block_max"]},
+                        {"ssim.mean", m["ssim"]["mean"]}, {"psnr.db", m["psnr"]["db"]}};
+        }
+        fs::path path = store.baseline_path(tc.name, o.label);
+        std::string change = "new";
+        if (fs::exists(path)) {
+            cv::Mat old = read_image(path.string()).pixels;
+            if (old.size() == rr.image.size()) {
+                json m = compare_images(old, rr.image, 0);
+                double d = m["flip"]["mean"];
+                change = d == 0 && m["psnr"]["db"].get<double>() >= 999 ? "unchanged"
+                                                                         : fmt::format("changed: FLIP vs old baseline {:.5f}", d);
+            } else {
+                change = "changed size";
+            }
+            std::ifstream f(fs::path(path).replace_extension(".json"));
+            json oldp = json::parse(f, nullptr, false);
+            if (oldp.is_object() && oldp.contains("accuracy") && accuracy.contains("flip.mean") &&
+                oldp["accuracy"].contains("flip.mean"))
+                change += fmt::format("; accuracy FLIP {:.5f} -> {:.5f}", oldp["accuracy"]["flip.mean"].get<double>(),
+                                      accuracy["flip.mean"].get<double>());
+        }
+        json prov = rr.provenance;
+        prov["test"] = tc.name;
+        prov["suite"] = tc.suite;
+        prov["method"] = tc.spec.method;
+        prov["variant"] = tc.variant;
+        prov["size"] = {rr.image.cols, rr.image.rows};
+        prov["label"] = o.label;
+        prov["accuracy"] = accuracy;
+        prov["commit"] = commit + (dirty ? "-dirty" : "");
+        prov["date"] = utc_now_iso();
+        prov["cpu_features"] = cpu_features();
+        prov["command"] = bless_command(tc) + (o.label.empty() ? "" : " --label " + o.label);
+        fmt::print("{:<9} {}  ({})\n", o.dry_run ? "would" : "blessed", tc.name, change);
+        if (!o.dry_run) GoldenStore::write_golden(path, rr.image, prov);
+    }
+    return failed ? kExitError : kExitPass;
+}
+
+} // namespace iblcheck

@@ -1,0 +1,234 @@
+#include "suite.h"
+
+#include <fnmatch.h>
+
+#include <fstream>
+#include <set>
+
+#include "harness/common/errors.h"
+#include "renderers/renderer.h"
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace iblcheck {
+
+namespace {
+
+const std::set<std::string> kMetrics = {"flip.mean", "flip.p99", "flip.block_max", "ssim.mean", "psnr.db"};
+
+struct Ctx {
+    std::string file;
+    [[noreturn]] void fail(const std::string& where, const std::string& problem) const {
+        throw InputError(file + ": " + where + ": " + problem);
+    }
+    void keys(const json& j, const std::string& where, const std::set<std::string>& allowed) const {
+        if (!j.is_object()) fail(where, "must be an object");
+        for (auto& [k, v] : j.items())
+            if (!allowed.count(k)) {
+                std::string list;
+                for (auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+                fail(where + "." + k, "unknown key; valid: " + list);
+            }
+    }
+    std::string str(const json& j, const std::string& where) const {
+        if (!j.is_string()) fail(where, "must be a string");
+        return j.get<std::string>();
+    }
+    double num(const json& j, const std::string& where) const {
+        if (!j.is_number()) fail(where, "must be a number");
+        return j.get<double>();
+    }
+    bool boolean(const json& j, const std::string& where) const {
+        if (!j.is_boolean()) fail(where, "must be true or false");
+        return j.get<bool>();
+    }
+    // Option values are written as strings or numbers; both become the CLI's text form.
+    std::string option_value(const json& j, const std::string& where) const {
+        if (j.is_string()) return j.get<std::string>();
+        if (j.is_number_integer()) return std::to_string(j.get<long long>());
+        if (j.is_number()) {
+            std::string s = json(j.get<double>()).dump();
+            return s;
+        }
+        if (j.is_boolean()) return j.get<bool>() ? "1" : "0";
+        fail(where, "must be a string or a number");
+    }
+    OptionMap options(const json& j, const std::string& where) const {
+        if (!j.is_object()) fail(where, "must be an object of option: value");
+        OptionMap m;
+        for (auto& [k, v] : j.items()) m.set(k, option_value(v, where + "." + k));
+        return m;
+    }
+    std::map<std::string, Bound> bounds(const json& j, const std::string& where) const {
+        std::map<std::string, Bound> out;
+        keys(j, where, kMetrics);
+        for (auto& [metric, b] : j.items()) {
+            std::string w = where + "." + metric;
+            keys(b, w, {"min", "max"});
+            Bound bound;
+            if (b.contains("min")) bound.min = num(b["min"], w + ".min");
+            if (b.contains("max")) bound.max = num(b["max"], w + ".max");
+            if (!bound.min && !bound.max) fail(w, "needs min or max");
+            out[metric] = bound;
+        }
+        return out;
+    }
+    std::map<std::string, Band> bands(const json& j, const std::string& where) const {
+        std::map<std::string, Band> out;
+        keys(j, where, kMetrics);
+        for (auto& [metric, b] : j.items()) {
+            std::string w = where + "." + metric;
+            keys(b, w, {"below", "above", "abs"});
+            Band band;
+            if (b.contains("below")) band.below = num(b["below"], w + ".below");
+            if (b.contains("above")) band.above = num(b["above"], w + ".above");
+            if (b.contains("abs")) band.abs = num(b["abs"], w + ".abs");
+            if (band.below < 0 || band.above < 0 || band.abs < 0) fail(w, "band widths must be >= 0");
+            out[metric] = band;
+        }
+        return out;
+    }
+};
+
+void parse_size(const Ctx& c, const json& j, const std::string& where, int& w, int& h) {
+    std::string s = c.str(j, where);
+    if (std::sscanf(s.c_str(), "%dx%d", &w, &h) != 2 || w < 1 || h < 1 || w > 8192 || h > 8192)
+        c.fail(where, "'" + s + "' is not WxH");
+}
+
+std::string sanitize_env(const std::string& env) { return env; }
+
+} // namespace
+
+fs::path suite_dir() {
+    if (const char* e = std::getenv("IBLCHECK_SUITE_DIR"); e && *e) return e;
+    return fs::path(IBLCHECK_SOURCE_DIR) / "harness" / "suites";
+}
+
+std::vector<std::string> suite_names() {
+    std::vector<std::string> out;
+    if (fs::is_directory(suite_dir()))
+        for (auto& e : fs::directory_iterator(suite_dir()))
+            if (e.path().extension() == ".json") out.push_back(e.path().stem().string());
+    std::sort(out.begin(), out.end());
+    return out;
+}
+
+bool glob_match(const std::string& pattern, const std::string& name) {
+    return pattern.empty() || fnmatch(pattern.c_str(), name.c_str(), 0) == 0;
+}
+
+Suite load_suite(const std::string& name_or_path) {
+    fs::path file = name_or_path;
+    if (file.extension() != ".json") file = suite_dir() / (name_or_path + ".json");
+    if (!fs::exists(file)) {
+        std::string list;
+        for (auto& n : suite_names()) list += (list.empty() ? "" : ", ") + n;
+        throw InputError(file.string() + ": no such suite; available: " + list);
+    }
+    Ctx c{file.string()};
+    json root;
+    try {
+        std::ifstream f(file);
+        root = json::parse(f);
+    } catch (const json::parse_error& e) {
+        throw InputError(file.string() + ": not valid JSON: " + e.what());
+    }
+    c.keys(root, "(top level)", {"suite", "description", "defaults", "tests"});
+    if (!root.contains("suite")) c.fail("suite", "missing required key");
+    if (!root.contains("tests")) c.fail("tests", "missing required key");
+    Suite suite;
+    suite.file = file;
+    suite.name = c.str(root["suite"], "suite");
+    if (root.contains("description")) suite.description = c.str(root["description"], "description");
+
+    json defaults = root.value("defaults", json::object());
+    c.keys(defaults, "defaults", {"env", "size", "jobs", "baseline_tolerances", "reference_band"});
+    std::string default_env = defaults.contains("env") ? c.str(defaults["env"], "defaults.env") : "studio";
+    int dw = 0, dh = 0;
+    if (defaults.contains("size")) parse_size(c, defaults["size"], "defaults.size", dw, dh);
+    if (defaults.contains("jobs")) suite.jobs = int(c.num(defaults["jobs"], "defaults.jobs"));
+    auto default_bounds = defaults.contains("baseline_tolerances")
+                              ? c.bounds(defaults["baseline_tolerances"], "defaults.baseline_tolerances")
+                              : std::map<std::string, Bound>{};
+    auto default_bands = defaults.contains("reference_band")
+                             ? c.bands(defaults["reference_band"], "defaults.reference_band")
+                             : std::map<std::string, Band>{};
+
+    if (!root["tests"].is_array()) c.fail("tests", "must be an array");
+    std::set<std::string> names;
+    for (size_t i = 0; i < root["tests"].size(); ++i) {
+        const json& t = root["tests"][i];
+        std::string w = "tests[" + std::to_string(i) + "]";
+        c.keys(t, w, {"scene", "method", "env", "size", "options", "variants", "baseline", "reference",
+                      "baseline_tolerances", "reference_band", "tags"});
+        if (!t.contains("scene")) c.fail(w + ".scene", "missing required key");
+        if (!t.contains("method")) c.fail(w + ".method", "missing required key");
+        std::vector<std::string> envs;
+        if (!t.contains("env")) envs.push_back(default_env);
+        else if (t["env"].is_array())
+            for (size_t k = 0; k < t["env"].size(); ++k) envs.push_back(c.str(t["env"][k], w + ".env[" + std::to_string(k) + "]"));
+        else envs.push_back(c.str(t["env"], w + ".env"));
+        OptionMap base_opts = t.contains("options") ? c.options(t["options"], w + ".options") : OptionMap{};
+        std::vector<OptionMap> variants;
+        if (t.contains("variants")) {
+            if (!t["variants"].is_array()) c.fail(w + ".variants", "must be an array of option objects");
+            for (size_t k = 0; k < t["variants"].size(); ++k)
+                variants.push_back(c.options(t["variants"][k], w + ".variants[" + std::to_string(k) + "]"));
+        } else {
+            variants.emplace_back();
+        }
+        TestCase proto;
+        proto.suite = suite.name;
+        proto.spec.scene = c.str(t["scene"], w + ".scene");
+        proto.spec.method = c.str(t["method"], w + ".method");
+        proto.spec.width = dw;
+        proto.spec.height = dh;
+        if (t.contains("size")) parse_size(c, t["size"], w + ".size", proto.spec.width, proto.spec.height);
+        if (t.contains("baseline")) proto.baseline = c.boolean(t["baseline"], w + ".baseline");
+        if (t.contains("reference")) proto.reference = c.boolean(t["reference"], w + ".reference");
+        proto.baseline_tolerances = default_bounds;
+        if (t.contains("baseline_tolerances"))
+            for (auto& [k, v] : c.bounds(t["baseline_tolerances"], w + ".baseline_tolerances")) proto.baseline_tolerances[k] = v;
+        proto.reference_band = default_bands;
+        if (t.contains("reference_band"))
+            for (auto& [k, v] : c.bands(t["reference_band"], w + ".reference_band")) proto.reference_band[k] = v;
+        if (t.contains("tags"))
+            for (size_t k = 0; k < t["tags"].size(); ++k) proto.tags.push_back(c.str(t["tags"][k], w + ".tags"));
+
+        for (const auto& env : envs)
+            for (const auto& variant : variants) {
+                TestCase tc = proto;
+                tc.spec.env = env;
+                tc.spec.options = base_opts;
+                for (auto& [k, v] : variant.values()) tc.spec.options.set(k, v);
+                tc.variant = variant.values().empty() ? "default" : variant.canonical();
+                tc.name = tc.spec.method + "." + tc.spec.scene + "." + sanitize_env(env) + "." + tc.variant;
+                try {
+                    validate_spec(tc.spec);
+                } catch (const UsageError& e) {
+                    c.fail(w, e.what());
+                }
+                if (!names.insert(tc.name).second) c.fail(w, "duplicate test name " + tc.name);
+                suite.tests.push_back(std::move(tc));
+            }
+    }
+    if (suite.tests.empty()) c.fail("tests", "the suite has no tests");
+    return suite;
+}
+
+std::vector<TestCase> select_tests(const Suite& suite, const std::string& filter, int shard_index, int shard_count) {
+    if (shard_count < 1 || shard_index < 0 || shard_index >= shard_count)
+        throw UsageError("--shard " + std::to_string(shard_index) + "/" + std::to_string(shard_count) +
+                         ": need 0 <= index < count");
+    std::vector<TestCase> out;
+    size_t k = 0;
+    for (const auto& t : suite.tests) {
+        if (!glob_match(filter, t.name)) continue;
+        if (int(k++ % size_t(shard_count)) == shard_index) out.push_back(t);
+    }
+    return out;
+}
+
+} // namespace iblcheck

@@ -1,0 +1,70 @@
+// Suites are data: harness/suites/<name>.json, one schema, validated with errors that name the
+// file, the key and the problem. A suite expands into TestCases: each entry may list several
+// environments and variants, and every combination is one test named
+//   <method>.<scene>.<env>.<variant>      (variant: "k=v,k=v" of the variant's options, or "default")
+//
+// Schema (keys marked * are required):
+// {
+//   "suite"*: "ci",  "description": "...",
+//   "defaults": { "env": "studio", "size": "WxH", "jobs": 2,
+//                 "baseline_tolerances": { METRIC: {"min": x, "max": y}, ... },
+//                 "reference_band": { METRIC: {"below": rel, "above": rel, "abs": a}, ... } },
+//   "tests"*: [ { "scene"*: "roughness_sweep", "method"*: "mobile",
+//                "env": "studio" | ["studio", "sky_sun"], "size": "WxH",
+//                "options": {k: v}, "variants": [{k: v}, ...],
+//                "baseline": true, "reference": true,
+//                "baseline_tolerances": {...}, "reference_band": {...}, "tags": ["..."] } ]
+// }
+// METRIC is one of flip.mean, flip.p99, flip.block_max, ssim.mean, psnr.db.
+// baseline_tolerances bound the difference to the approved baseline (deterministic renders: tight).
+// reference_band bounds the accuracy against the ground truth around the value approved at bless
+// time: [v·(1 − below) − abs, v·(1 + above) + abs]; under the band is `improved`, over it `fail`.
+#pragma once
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "renderers/render_api.h"
+
+namespace iblcheck {
+
+struct Bound {
+    std::optional<double> min, max;
+};
+struct Band {
+    double below = 0.1, above = 0.1, abs = 0.0;
+};
+
+struct TestCase {
+    std::string name;
+    std::string suite;
+    std::string variant;             // "default" or canonical k=v list of the variant options
+    TestSpec spec;
+    bool baseline = true;            // compare with approved baselines
+    bool reference = true;           // measure accuracy against the reference golden if one exists
+    std::map<std::string, Bound> baseline_tolerances;
+    std::map<std::string, Band> reference_band;
+    std::vector<std::string> tags;
+};
+
+struct Suite {
+    std::string name;
+    std::string description;
+    std::filesystem::path file;
+    int jobs = 2;
+    std::vector<TestCase> tests;
+};
+
+// Folder of suite files: <source>/harness/suites (IBLCHECK_SUITE_DIR overrides).
+std::filesystem::path suite_dir();
+std::vector<std::string> suite_names();
+// `name_or_path`: a suite name in suite_dir() or a path to a .json file. Throws InputError.
+Suite load_suite(const std::string& name_or_path);
+// Glob with * and ? (fnmatch semantics on the whole name).
+bool glob_match(const std::string& pattern, const std::string& name);
+// Keeps the tests of shard `index` of `count` (round robin over the suite order).
+std::vector<TestCase> select_tests(const Suite& suite, const std::string& filter, int shard_index, int shard_count);
+
+} // namespace iblcheck
