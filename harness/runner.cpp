@@ -16,6 +16,7 @@
 #include "metrics/image_io.h"
 #include "metrics/psnr.h"
 #include "metrics/ssim.h"
+#include "metrics/temporal.h"
 #include "renderers/renderer.h"
 #include "renderers/scenes/scene.h"
 
@@ -104,7 +105,88 @@ struct Worker {
         return o;
     }()) {}
     Renderer renderer;
+    // Tone-mapped frames of sequences already rendered (the reference and `off` sequences are shared
+    // by every variant of a scene).
+    std::map<std::string, std::vector<cv::Mat>> sequences;
+
+    const std::vector<cv::Mat>& sequence(TestSpec spec, int frames) {
+        std::string key = spec.method + "|" + spec.scene + "|" + spec.env + "|" + std::to_string(spec.width) + "x" +
+                          std::to_string(spec.height) + "|" + spec.options.canonical() + "|" + std::to_string(frames);
+        auto it = sequences.find(key);
+        if (it != sequences.end()) return it->second;
+        std::vector<cv::Mat> out;
+        for (int f = 0; f < frames; ++f) {
+            spec.options.set("frame", std::to_string(f));
+            cv::Mat img = renderer.render(spec).image;
+            check_finite(img, spec.scene + " frame " + std::to_string(f));
+            out.push_back(display_transform(img));
+        }
+        return sequences.emplace(key, std::move(out)).first->second;
+    }
 };
+
+struct SequenceScore {
+    double flicker = 0, variation_ratio = 0, flip_mean = 0;
+};
+SequenceScore score_sequence(const std::vector<cv::Mat>& test, const std::vector<cv::Mat>& ref, int flip_threads) {
+    SequenceScore s;
+    TemporalResult t = compute_temporal(test, ref);
+    s.flicker = t.flicker;
+    s.variation_ratio = t.variation_ratio;
+    FlipOptions fo;
+    fo.threads = flip_threads;
+    for (size_t i = 0; i < test.size(); ++i) s.flip_mean += compute_flip_ldr(ref[i], test[i], fo).mean;
+    s.flip_mean /= double(test.size());
+    return s;
+}
+
+// Renders the test's sequence, its `off` sequence and the reference sequence; scores and checks them.
+// Appends failures to `problems`; returns the "temporal" results object.
+json run_temporal(const TestCase& tc, Worker& w, const fs::path& img_dir, int flip_threads, bool& failed,
+                  std::vector<std::string>& problems) {
+    const TemporalSpec& ts = tc.temporal;
+    TestSpec off = tc.spec, ref = tc.spec;
+    off.options.set("specular_aa", "off");
+    ref.options.set("specular_aa", "off");
+    ref.options.set("ssaa", std::to_string(ts.reference_ssaa * tc.spec.options.get_int("ssaa", 2)));
+    const auto& test_frames = w.sequence(tc.spec, ts.frames);
+    const auto& off_frames = w.sequence(off, ts.frames);
+    const auto& ref_frames = w.sequence(ref, ts.frames);
+    SequenceScore st = score_sequence(test_frames, ref_frames, flip_threads);
+    SequenceScore so = score_sequence(off_frames, ref_frames, flip_threads);
+    json j = {{"frames_count", ts.frames},
+              {"flicker", st.flicker},
+              {"variation_ratio", st.variation_ratio},
+              {"flip_mean", st.flip_mean},
+              {"off", {{"flicker", so.flicker}, {"variation_ratio", so.variation_ratio}, {"flip_mean", so.flip_mean}}},
+              {"flicker_ratio", so.flicker > 0 ? st.flicker / so.flicker : 1.0},
+              {"flip_ratio", so.flip_mean > 0 ? st.flip_mean / so.flip_mean : 1.0}};
+    j["checks"] = json::array();
+    for (auto& [metric, bound] : ts.checks) {
+        double v = j[metric].get<double>();
+        bool ok = (!bound.min || v >= *bound.min) && (!bound.max || v <= *bound.max);
+        j["checks"].push_back({{"metric", "temporal." + metric}, {"value", v},
+                               {"min", bound.min ? json(*bound.min) : json()},
+                               {"max", bound.max ? json(*bound.max) : json()}, {"status", ok ? "pass" : "fail"}});
+        if (!ok) {
+            failed = true;
+            problems.push_back(fmt::format("temporal: {} {} outside [{}, {}]", metric, fmt_num(v),
+                                           bound.min ? fmt_num(*bound.min) : "-inf", bound.max ? fmt_num(*bound.max) : "inf"));
+        }
+    }
+    if (!img_dir.empty()) {
+        fs::create_directories(img_dir);
+        std::string base = "images/" + img_dir.filename().string() + "/";
+        for (int f = 0; f < ts.frames; ++f) {
+            std::string tf = fmt::format("frame{:03d}.png", f), rf = fmt::format("ref{:03d}.png", f);
+            write_png((img_dir / tf).string(), test_frames[size_t(f)]);
+            write_png((img_dir / rf).string(), ref_frames[size_t(f)]);
+            j["frames"].push_back(base + tf);
+            j["reference_frames"].push_back(base + rf);
+        }
+    }
+    return j;
+}
 
 void write_test_png(const fs::path& dir, const std::string& name, const cv::Mat& linear) {
     fs::create_directories(dir);
@@ -151,7 +233,10 @@ json run_test(const TestCase& tc, Worker& w, const GoldenStore& store, const fs:
         r["texture_fetches_per_pixel"] = rr.texture_fetches_per_pixel;
         r["provenance"] = rr.provenance;
         check_finite(rr.image, tc.name + " (render)");
-        if (!img_dir.empty()) write_test_png(img_dir, "test.png", rr.image);
+        if (!img_dir.empty()) {
+            write_test_png(img_dir, "test.png", rr.image);
+            r["image"] = rel("test.png");
+        }
 
         std::vector<std::string> problems;
         bool any_fail = false, improved = false, missing = false;
@@ -286,6 +371,9 @@ json run_test(const TestCase& tc, Worker& w, const GoldenStore& store, const fs:
                 r["comparisons"].push_back(c);
             }
         }
+
+        // 3. Temporal sequences.
+        if (tc.temporal.frames > 0) r["temporal"] = run_temporal(tc, w, img_dir, flip_threads, any_fail, problems);
 
         std::string verdict = missing ? "missing-golden" : any_fail ? "fail" : improved ? "improved" : "pass";
         r["verdict"] = verdict;

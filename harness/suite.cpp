@@ -162,7 +162,7 @@ Suite load_suite(const std::string& name_or_path) {
         const json& t = root["tests"][i];
         std::string w = "tests[" + std::to_string(i) + "]";
         c.keys(t, w, {"scene", "method", "env", "size", "options", "variants", "baseline", "reference",
-                      "baseline_tolerances", "reference_band", "tags"});
+                      "baseline_tolerances", "reference_band", "tags", "temporal"});
         if (!t.contains("scene")) c.fail(w + ".scene", "missing required key");
         if (!t.contains("method")) c.fail(w + ".method", "missing required key");
         std::vector<std::string> envs;
@@ -197,6 +197,27 @@ Suite load_suite(const std::string& name_or_path) {
         if (t.contains("tags"))
             for (size_t k = 0; k < t["tags"].size(); ++k) proto.tags.push_back(c.str(t["tags"][k], w + ".tags"));
 
+        if (t.contains("temporal")) {
+            const json& tj = t["temporal"];
+            std::string tw = w + ".temporal";
+            c.keys(tj, tw, {"frames", "reference_ssaa", "checks"});
+            if (!tj.contains("frames")) c.fail(tw + ".frames", "missing required key");
+            proto.temporal.frames = int(c.num(tj["frames"], tw + ".frames"));
+            if (proto.temporal.frames < 2 || proto.temporal.frames > 256) c.fail(tw + ".frames", "must be in 2..256");
+            if (tj.contains("reference_ssaa")) proto.temporal.reference_ssaa = int(c.num(tj["reference_ssaa"], tw + ".reference_ssaa"));
+            if (tj.contains("checks")) {
+                const json& cj = tj["checks"];
+                c.keys(cj, tw + ".checks", {"flicker", "variation_ratio", "flip_mean", "flicker_ratio", "flip_ratio"});
+                for (auto& [k, b] : cj.items()) {
+                    std::string bw = tw + ".checks." + k;
+                    c.keys(b, bw, {"min", "max"});
+                    Bound bound;
+                    if (b.contains("min")) bound.min = c.num(b["min"], bw + ".min");
+                    if (b.contains("max")) bound.max = c.num(b["max"], bw + ".max");
+                    proto.temporal.checks[k] = bound;
+                }
+            }
+        }
         for (const auto& env : envs)
             for (const auto& variant : variants) {
                 TestCase tc = proto;

@@ -13,7 +13,8 @@
 //                "env": "studio" | ["studio", "sky_sun"], "size": "WxH",
 //                "options": {k: v}, "variants": [{k: v}, ...],
 //                "baseline": true, "reference": true,
-//                "baseline_tolerances": {...}, "reference_band": {...}, "tags": ["..."] } ]
+//                "baseline_tolerances": {...}, "reference_band": {...}, "tags": ["..."],
+//                "temporal": {"frames": 32, "reference_ssaa": 8, "checks": {NAME: {"min": x, "max": y}}} } ]
 // }
 // METRIC is one of flip.mean, flip.p99, flip.block_max, ssim.mean, psnr.db.
 // baseline_tolerances bound the difference to the approved baseline (deterministic renders: tight).
@@ -37,6 +38,16 @@ struct Band {
     double below = 0.1, above = 0.1, abs = 0.0;
 };
 
+// Temporal tests (animated scenes): every frame of the test, of the same scene with
+// specular_aa=off (the comparison) and of the reference sequence (the same shading, ssaa ×
+// reference_ssaa, specular_aa=off: a near-perfect pixel filter) is rendered and tone-mapped;
+// checks bound flicker, flip_mean and their ratios to the `off` sequence.
+struct TemporalSpec {
+    int frames = 0;                       // 0: not a temporal test
+    int reference_ssaa = 8;
+    std::map<std::string, Bound> checks;  // flicker, variation_ratio, flip_mean, flicker_ratio, flip_ratio
+};
+
 struct TestCase {
     std::string name;
     std::string suite;
@@ -47,6 +58,7 @@ struct TestCase {
     std::map<std::string, Bound> baseline_tolerances;
     std::map<std::string, Band> reference_band;
     std::vector<std::string> tags;
+    TemporalSpec temporal;
 };
 
 struct Suite {

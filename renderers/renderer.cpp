@@ -27,6 +27,9 @@ std::vector<OptionInfo> option_catalog() {
         {"metallic", "0", "0..1", "all", "metalness of the `sphere` scene"},
         {"base_color", "1,1,1", "r,g,b", "all", "base colour of the `sphere` scene"},
         {"env_rotation", "0", "degrees", "all", "turns the environment about +Y"},
+        {"frame", "0", "integer", "all", "frame of an animated scene (bumpy_sphere)"},
+        {"bump_amplitude", "0.0008", ">=0", "all", "height of the bumpy_sphere normal detail"},
+        {"bump_frequency", "200", ">0", "all", "spatial frequency of the bumpy_sphere normal detail (radius-1 units)"},
         {"ssaa", "2", "1..16", "mobile,sampled", "n x n rays per pixel (silhouettes)"},
         {"cube_size", "128 (sampled: 256)", "8..2048, power of two", "mobile,sampled", "base size of the cubemaps"},
         {"mips", "7", "1..log2(cube_size)+1", "mobile", "levels of the prefiltered chain"},
@@ -44,7 +47,7 @@ std::vector<OptionInfo> option_catalog() {
         {"storage", "rgba16f", "rgba16f|rgba32f|rgbm8|r11g11b10", "mobile", "prefiltered cube storage"},
         {"rgbm_range", "6", ">0", "mobile", "RGBM range (storage=rgbm8)"},
         {"precision", "highp", "highp|mediump", "mobile", "mediump shades in float16_t"},
-        {"specular_aa", "off", "off", "mobile", "specular anti-aliasing for low roughness"},
+        {"specular_aa", "off", "off|tokuyoshi|rjump|toksvig", "mobile", "specular anti-aliasing for low roughness"},
         {"specular_aa_variance", "0.25", ">=0", "mobile", "specular AA: screen-space variance scale"},
         {"specular_aa_threshold", "0.18", ">=0", "mobile", "specular AA: clamp of the added roughness"},
         {"samples", "64", "1..65536", "sampled", "GGX samples per ray"},
@@ -98,6 +101,10 @@ RenderResult Renderer::render(const TestSpec& spec) {
     auto t0 = std::chrono::steady_clock::now();
     RenderResult r;
     if (spec.method == "reference") {
+        for (const Sphere& s : build_scene(spec.scene, spec.options).spheres)
+            if (s.bump_amplitude > 0)
+                throw UsageError("scene " + spec.scene + ": the reference integrator models no normal detail; the "
+                                 "temporal reference is the mobile method supersampled (ssaa=8, specular_aa=off)");
         r = render_reference(spec, env);
     } else if (spec.method == "mobile") {
         r = render_mobile(gpu(), env, spec);

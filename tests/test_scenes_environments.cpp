@@ -275,7 +275,18 @@ TEST(Scene, MaterialOptions) {
     OptionMap bad;
     bad.set("roughness", "1.5");
     EXPECT_THROW(build_scene("sphere", bad), UsageError);
-    EXPECT_EQ(scene_option_keys().size(), 3u);
+    EXPECT_EQ(scene_option_keys(), (std::vector<std::string>{"roughness", "metallic", "base_color", "frame",
+                                                              "bump_amplitude", "bump_frequency"}));
+}
+
+TEST(Scene, BumpySphereMovesItsDetailEachFrame) {
+    OptionMap f0, f3;
+    f3.set("frame", "3");
+    Scene a = build_scene("bumpy_sphere", f0), b = build_scene("bumpy_sphere", f3);
+    ASSERT_EQ(a.spheres.size(), 1u);
+    EXPECT_GT(a.spheres[0].bump_amplitude, 0.0f);
+    EXPECT_FLOAT_EQ(a.spheres[0].material.roughness, 0.05f);
+    EXPECT_FLOAT_EQ(b.spheres[0].bump_phase - a.spheres[0].bump_phase, 3 * 0.9f);
 }
 
 TEST(Scene, RoughnessSweepLayout) {

@@ -166,4 +166,29 @@ IblResources run_precompute(GpuSession& gpu, const Environment& env, const Preco
     return r;
 }
 
+std::shared_ptr<IblResources> precompute_cached(GpuSession& gpu, const Environment& env, const PrecomputeSettings& s,
+                                                std::vector<PassTiming>& timings, bool& cached) {
+    std::string key = "ibl;" + env.content_hash + ";" + std::to_string(s.cube_size) + ";" + std::to_string(s.mips) + ";" +
+                      std::to_string(s.prefilter_samples) + ";" + s.mip_mapping + ";" + s.storage + ";" +
+                      std::to_string(s.rgbm_range) + ";" + std::to_string(s.prefiltered) + ";" + std::to_string(s.lut) +
+                      ";" + std::to_string(s.lut_size) + ";" + std::to_string(s.lut_samples) + ";" +
+                      std::to_string(s.irradiance_cube) + ";" + std::to_string(s.irradiance_size) + ";" +
+                      std::to_string(s.env_rotation_deg) + ";" + vk::shader_tree_hash();
+    struct Entry {
+        std::shared_ptr<IblResources> ibl;
+        std::vector<PassTiming> timings;
+    };
+    if (auto e = gpu.cached<Entry>(key)) {
+        cached = true;
+        timings.insert(timings.end(), e->timings.begin(), e->timings.end());
+        return e->ibl;
+    }
+    cached = false;
+    auto e = std::make_shared<Entry>();
+    e->ibl = std::make_shared<IblResources>(run_precompute(gpu, env, s, e->timings));
+    timings.insert(timings.end(), e->timings.begin(), e->timings.end());
+    gpu.store(key, e);
+    return e->ibl;
+}
+
 } // namespace iblcheck

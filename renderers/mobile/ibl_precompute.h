@@ -41,6 +41,12 @@ struct IblResources {
 IblResources run_precompute(GpuSession& gpu, const Environment& env, const PrecomputeSettings& s,
                             std::vector<PassTiming>& timings);
 
+// run_precompute through the session's cache: the same environment and settings reuse the device
+// resources; `timings` receives the passes' timings as first measured (they are the cost of the
+// precompute, whether or not this render paid it). Sets `cached` when reused.
+std::shared_ptr<IblResources> precompute_cached(GpuSession& gpu, const Environment& env, const PrecomputeSettings& s,
+                                                std::vector<PassTiming>& timings, bool& cached);
+
 // Defines that select the storage format in GLSL (storage.glsl).
 vk::Defines storage_defines(const PrecomputeSettings& s, bool native_r11g11b10);
 std::string mip_mapping_define(const std::string& name);

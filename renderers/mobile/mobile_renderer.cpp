@@ -42,14 +42,16 @@ RenderResult render_mobile(GpuSession& gpu, const Environment& env, const TestSp
     std::string precision = o.get_choice("precision", "highp", {"highp", "mediump"});
     std::string dominant = o.get_choice("dominant_dir", "off", {"off", "lagarde", "filament"});
     std::string normalization = o.get_choice("normalization", "off", {"off", "ue4"});
-    std::string spec_aa = o.get_choice("specular_aa", "off", {"off"});
+    std::string spec_aa = o.get_choice("specular_aa", "off", {"off", "tokuyoshi", "rjump", "toksvig"});
     if (ps.prefilter_samples < 1 || ps.prefilter_samples > 65536)
         throw UsageError("option 'prefilter_samples' must be in 1..65536");
     if (precision == "mediump" && !gpu.ctx().info().shader_float16)
         throw EnvironmentError(gpu.ctx().info().device_name + ": precision=mediump needs shaderFloat16");
 
     RenderResult result;
-    IblResources ibl = run_precompute(gpu, env, ps, result.timings);
+    bool cached = false;
+    auto ibl_ptr = precompute_cached(gpu, env, ps, result.timings, cached);
+    const IblResources& ibl = *ibl_ptr;
 
     vk::Defines defs = storage_defines(ps, ibl.native_r11g11b10);
     defs["MIP_MAPPING"] = mip_mapping_define(ps.mip_mapping);
@@ -58,7 +60,7 @@ RenderResult render_mobile(GpuSession& gpu, const Environment& env, const TestSp
     defs["DOMINANT_DIR"] = index_of("dominant_dir", dominant, {"off", "lagarde", "filament"});
     defs["NORMALIZATION"] = index_of("normalization", normalization, {"off", "ue4"});
     defs["PRECISION_MEDIUMP"] = precision == "mediump" ? "1" : "0";
-    defs["SPECULAR_AA"] = "0";
+    defs["SPECULAR_AA"] = index_of("specular_aa", spec_aa, {"off", "tokuyoshi", "rjump", "toksvig"});
     const auto& shade = gpu.pipeline("shade_spheres.comp", defs,
                                      {kStorageBuffer, kSampled, kStorageBuffer, kSampled, kSampled, kStorageBuffer}, 48);
 
@@ -106,6 +108,7 @@ RenderResult render_mobile(GpuSession& gpu, const Environment& env, const TestSp
     double per_hit = 1.0 + (ps.lut ? 1.0 : 0.0) + (ps.irradiance_cube ? 1.0 : 0.0);
     result.texture_fetches_per_pixel = coverage * pc.ssaa * pc.ssaa * per_hit;
     result.provenance = {{"method", "mobile"},
+                         {"precompute_cached", cached},
                          {"cube_size", ps.cube_size},
                          {"mips", std::min(ps.mips, ibl.full_mips)},
                          {"storage_native", ps.storage != "r11g11b10" || ibl.native_r11g11b10},

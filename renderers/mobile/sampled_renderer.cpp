@@ -21,7 +21,9 @@ RenderResult render_sampled(GpuSession& gpu, const Environment& env, const TestS
     if (samples < 1 || samples > 65536) throw UsageError("option 'samples' must be in 1..65536");
 
     RenderResult result;
-    IblResources ibl = run_precompute(gpu, env, ps, result.timings);
+    bool cached = false;
+    auto ibl_ptr = precompute_cached(gpu, env, ps, result.timings, cached);
+    const IblResources& ibl = *ibl_ptr;
     const auto& shade = gpu.pipeline("shade_sampled.comp", {},
                                      {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
                                       VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
@@ -55,7 +57,7 @@ RenderResult render_sampled(GpuSession& gpu, const Environment& env, const TestS
     for (auto& [name, ms] : timer.results()) result.timings.push_back({name, ms, true, false});
     double coverage = read_back_image(out, width, height, result.image);
     result.texture_fetches_per_pixel = coverage * pc.ssaa * pc.ssaa * samples;
-    result.provenance = {{"method", "sampled"}, {"samples", samples}, {"cube_size", ps.cube_size},
+    result.provenance = {{"method", "sampled"}, {"precompute_cached", cached}, {"samples", samples}, {"cube_size", ps.cube_size},
                          {"seed", pc.seed}};
     return result;
 }

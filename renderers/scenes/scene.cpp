@@ -115,6 +115,29 @@ Scene build_grazing(const OptionMap& o) {
     return s;
 }
 
+// Animated normal detail for the temporal suite: the bumps (renderers/shaders/scene.glsl,
+// bump_normal) move by kBumpPhasePerFrame radians each frame, a fixed time step.
+constexpr float kBumpAmplitude = 0.0008f;  // tilts the normal by up to ~0.16 rad
+constexpr float kBumpFrequency = 200.0f;  // ≈ 1.8 px wavelength at 128 px: sub-pixel detail that sparkles
+constexpr float kBumpPhasePerFrame = 0.9f;
+
+Scene build_bumpy_sphere(const OptionMap& o) {
+    Scene s = build_sphere([&] {
+        OptionMap m;
+        m.set("roughness", o.get_string("roughness", "0.05"));
+        m.set("metallic", o.get_string("metallic", "1"));
+        m.set("base_color", o.get_string("base_color", "0.95,0.93,0.88"));
+        return m;
+    }());
+    s.name = "bumpy_sphere";
+    Sphere& sp = s.spheres[0];
+    sp.bump_amplitude = float(o.get_double("bump_amplitude", kBumpAmplitude));
+    sp.bump_frequency = float(o.get_double("bump_frequency", kBumpFrequency));
+    sp.bump_phase = kBumpPhasePerFrame * float(o.get_int("frame", 0));
+    s.labels[0] = "bumpy r=" + fmt_r(sp.material.roughness);
+    return s;
+}
+
 const std::vector<SceneDef>& defs() {
     static const std::vector<SceneDef> d = {
         {"sphere",
@@ -138,6 +161,11 @@ const std::vector<SceneDef>& defs() {
          "128x128 orthographic close-up of the limb of a radius-1 sphere (view x in [0.74,1.06], y in [-0.16,0.16]): "
          "most covered pixels have n.v < 0.6, many near 0. Material options as for sphere.",
          build_grazing},
+        {"bumpy_sphere",
+         "128x128: the sphere scene with moving high-frequency normal detail (analytic sine bumps, "
+         "amplitude 0.0008, frequency 200, phase +0.9 rad per frame; options frame=N, bump_amplitude, bump_frequency). "
+         "Defaults roughness 0.05, metallic 1: the low-roughness case where specular highlights sparkle and crawl.",
+         build_bumpy_sphere},
     };
     return d;
 }
@@ -151,7 +179,7 @@ std::vector<SceneInfo> scene_catalog() {
 }
 
 const std::vector<std::string>& scene_option_keys() {
-    static const std::vector<std::string> keys = {"roughness", "metallic", "base_color"};
+    static const std::vector<std::string> keys = {"roughness", "metallic", "base_color", "frame", "bump_amplitude", "bump_frequency"};
     return keys;
 }
 

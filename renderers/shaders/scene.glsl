@@ -56,4 +56,31 @@ int intersect_scene(vec3 o, vec3 d, out float t_hit) {
     return best;
 }
 
+// Animated normal detail (bumpy_sphere): a height field h = A sin(f x + φ) sin(f y + 0.7 φ) on the
+// surface, with its exact gradient; the normal tilts by the gradient's tangential part,
+//   n' = normalize(n − (∇h − (∇h·n) n))      (Blinn 1978, "Simulation of Wrinkled Surfaces").
+vec3 bump_normal(vec3 p, vec3 n, vec4 roughness_bump) {
+    float amp = roughness_bump.y, f = roughness_bump.z, phase = roughness_bump.w;
+    if (amp <= 0.0) return n;
+    float sx = sin(f * p.x + phase), cx = cos(f * p.x + phase);
+    float sy = sin(f * p.y + 0.7 * phase), cy = cos(f * p.y + 0.7 * phase);
+    vec3 grad = amp * f * vec3(cx * sy, sx * cy, 0.0);
+    return normalize(n - (grad - dot(grad, n) * n));
+}
+
+// The shading normal and view vector of the surface under pixel position p (pixel units);
+// false for a miss. Used for the pixel's own rays and, by specular AA, its neighbours'.
+bool surface_at(vec2 p, vec2 size, out int id, out vec3 n, out vec3 v) {
+    vec3 o, d;
+    camera_ray(p, size, o, d);
+    float t;
+    id = intersect_scene(o, d, t);
+    if (id < 0) return false;
+    vec3 pos = o + d * t;
+    vec3 c = scene.spheres[id].center_radius.xyz;
+    n = bump_normal(pos - c, normalize(pos - c), scene.spheres[id].roughness_bump);
+    v = -d;
+    return true;
+}
+
 #endif

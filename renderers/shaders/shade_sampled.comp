@@ -29,14 +29,10 @@ layout(push_constant) uniform Push {
 } pc;
 
 vec4 shade_ray(vec2 p, uint sub) {
-    vec3 o, d;
-    camera_ray(p, vec2(pc.width, pc.height), o, d);
-    float t;
-    int id = intersect_scene(o, d, t);
-    if (id < 0) return vec4(0.0);
+    int id;
+    vec3 n, v;
+    if (!surface_at(p, vec2(pc.width, pc.height), id, n, v)) return vec4(0.0);
     SphereGpu s = scene.spheres[id];
-    vec3 n = normalize(o + d * t - s.center_radius.xyz);
-    vec3 v = -d;
     vec3 base = s.base_color_metallic.rgb;
     float metallic = s.base_color_metallic.a;
     float r = s.roughness_bump.x;

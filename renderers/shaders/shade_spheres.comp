@@ -51,17 +51,13 @@ vec3 diffuse_radiance(vec3 n) {
 
 // Shades one camera ray; returns rgb and 1 in alpha for a hit, 0 for a miss.
 vec4 shade_ray(vec2 p) {
-    vec3 o, d;
-    camera_ray(p, vec2(pc.width, pc.height), o, d);
-    float t;
-    int id = intersect_scene(o, d, t);
-    if (id < 0) return vec4(0.0);
+    int id;
+    vec3 n, v;
+    if (!surface_at(p, vec2(pc.width, pc.height), id, n, v)) return vec4(0.0);
     SphereGpu s = scene.spheres[id];
-    vec3 n = normalize(o + d * t - s.center_radius.xyz);
-    vec3 v = -d;
     vec3 base = s.base_color_metallic.rgb;
     float metallic = s.base_color_metallic.a;
-    float roughness = specular_aa_roughness(s.roughness_bump.x, n, p, vec2(pc.width, pc.height),
+    float roughness = specular_aa_roughness(s.roughness_bump.x, n, v, p, vec2(pc.width, pc.height),
                                             pc.specular_aa_variance, pc.specular_aa_threshold);
 
     vec3 diffuse_light = diffuse_radiance(n);

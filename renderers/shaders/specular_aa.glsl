@@ -1,12 +1,68 @@
-// Specular anti-aliasing for low roughness (option specular_aa). SPECULAR_AA: 0 off.
-// The hook every shading pass calls; the variants (tokuyoshi, rjump, toksvig) arrive with the
-// temporal suite.
+// Specular anti-aliasing for low roughness (option specular_aa). SPECULAR_AA: 0 off,
+// 1 tokuyoshi, 2 rjump, 3 toksvig. Each widens the GGX lobe where the normal (or the reflection
+// vector) varies within a pixel, so the prefiltered lookup averages what the pixel covers instead
+// of point-sampling a highlight that then sparkles from frame to frame. Fresnel is untouched: only
+// the roughness changes. A compute shader has no dFdx, so the derivatives are forward differences
+// of the neighbouring pixels' surfaces (what a fragment quad computes). Needs scene.glsl.
+//   variance  σ²: screen-space variance scale (Tokuyoshi & Kaplanyan use 0.25)
+//   threshold κ: clamp of the added α² (0.18)
 #ifndef IBLCHECK_SPECULAR_AA_GLSL
 #define IBLCHECK_SPECULAR_AA_GLSL
 #ifndef SPECULAR_AA
 #define SPECULAR_AA 0
 #endif
-float specular_aa_roughness(float roughness, vec3 n, vec2 pixel, vec2 size, float variance, float threshold) {
+
+float roughness_from_alpha2(float alpha2) { return sqrt(sqrt(clamp(alpha2, 0.0, 1.0))); }
+
+// Forward difference of the normal (or reflection vector) to the next pixel in x and y; zero
+// across a silhouette.
+void surface_differences(vec2 p, vec2 size, vec3 n, vec3 v, out vec3 dn_dx, out vec3 dn_dy, out vec3 dr_dx, out vec3 dr_dy) {
+    int id;
+    vec3 nx, vx, ny, vy;
+    vec3 r = reflect(-v, n);
+    dn_dx = dn_dy = dr_dx = dr_dy = vec3(0.0);
+    if (surface_at(p + vec2(1.0, 0.0), size, id, nx, vx)) {
+        dn_dx = nx - n;
+        dr_dx = reflect(-vx, nx) - r;
+    }
+    if (surface_at(p + vec2(0.0, 1.0), size, id, ny, vy)) {
+        dn_dy = ny - n;
+        dr_dy = reflect(-vy, ny) - r;
+    }
+}
+
+float specular_aa_roughness(float roughness, vec3 n, vec3 v, vec2 p, vec2 size, float variance, float threshold) {
+#if SPECULAR_AA == 0
     return roughness;
+#else
+    float alpha2 = roughness * roughness * roughness * roughness;
+    vec3 dn_dx, dn_dy, dr_dx, dr_dy;
+#if SPECULAR_AA == 1
+    // Tokuyoshi & Kaplanyan 2019, "Improved Geometric Specular Antialiasing" (eq. 13–14; the form
+    // Filament ships): α'² = α² + min(2σ²(|∂n/∂x|² + |∂n/∂y|²), κ).
+    surface_differences(p, size, n, v, dn_dx, dn_dy, dr_dx, dr_dy);
+    float kernel = 2.0 * variance * (dot(dn_dx, dn_dx) + dot(dn_dy, dn_dy));
+#elif SPECULAR_AA == 2
+    // The first seed's idea: find where the reflection vector R jumps across the pixel and widen the
+    // lobe to cover the jump. R = 2(n·v)n − v moves about twice as fast as n (more at grazing
+    // angles), hence the /4 that puts σ² on the same scale as tokuyoshi's.
+    surface_differences(p, size, n, v, dn_dx, dn_dy, dr_dx, dr_dy);
+    float kernel = 2.0 * variance * 0.25 * (dot(dr_dx, dr_dx) + dot(dr_dy, dr_dy));
+#else
+    // Toksvig 2005, "Mipmapping Normal Maps": the mean of the normals over the pixel footprint is
+    // shorter than 1 where they disagree; α'² = α² + (1 − |n̄|)/|n̄| (the GGX form in Hill's "Specular
+    // Showdown"), scaled by σ²/0.25 so the variance option means the same for every variant.
+    vec3 sum = vec3(0.0);
+    for (int j = 0; j < 2; ++j)
+        for (int i = 0; i < 2; ++i) {
+            int id;
+            vec3 ni, vi;
+            sum += surface_at(p + (vec2(i, j) - 0.5) * 0.5, size, id, ni, vi) ? ni : n;
+        }
+    float len = length(sum * 0.25);
+    float kernel = 4.0 * variance * (1.0 - len) / max(len, 1e-4);  // = σ² at the default variance 0.25
+#endif
+    return roughness_from_alpha2(alpha2 + min(kernel, threshold));
+#endif
 }
 #endif
