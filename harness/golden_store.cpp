@@ -33,6 +33,7 @@ Golden load_golden(const fs::path& exr, const std::string& label) {
     g.image_path = exr;
     g.label = label;
     g.image = read_image(exr.string()).pixels;
+    g.provenance = json::object();  // a golden without a sidecar still reads (its provenance is unknown)
     fs::path side = fs::path(exr).replace_extension(".json");
     if (fs::exists(side)) {
         try {

@@ -5,6 +5,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <mutex>
 #include <thread>
@@ -203,9 +204,142 @@ json timings_json(const RenderResult& r, double& precompute_ms, double& frame_ms
     return t;
 }
 
+bool bit_identical(const cv::Mat& a, const cv::Mat& b) {
+    return a.size() == b.size() && a.type() == b.type() && std::memcmp(a.data, b.data, a.total() * a.elemSize()) == 0;
+}
+
+std::mutex& environment_mutex() {
+    static std::mutex m;
+    return m;
+}
+
+// Renders `spec` in a fresh Vulkan instance with lavapipe limited to one thread (LP_NUM_THREADS is
+// read when the driver's screen is created). The process environment is shared, hence the lock.
+cv::Mat render_single_threaded(const TestSpec& spec, const std::string& device) {
+    std::lock_guard lock(environment_mutex());
+    const char* old = std::getenv("LP_NUM_THREADS");
+    std::string saved = old ? old : "";
+    setenv("LP_NUM_THREADS", "1", 1);
+    cv::Mat img;
+    try {
+        vk::ContextOptions o;
+        o.device = device;
+        Renderer r(o);
+        img = r.render(spec).image;
+    } catch (...) {
+        old ? setenv("LP_NUM_THREADS", saved.c_str(), 1) : unsetenv("LP_NUM_THREADS");
+        throw;
+    }
+    old ? setenv("LP_NUM_THREADS", saved.c_str(), 1) : unsetenv("LP_NUM_THREADS");
+    return img;
+}
+
+bool monte_carlo(const TestSpec& spec) { return spec.method == "sampled" || spec.method == "reference"; }
+
+// Stability of one test (issue 9). `base` is the render the verdict used, `golden` the baseline it
+// was compared with (may be empty), `reference` the reference golden (may be empty).
+json run_stability(const TestCase& tc, Worker& w, const cv::Mat& base, const cv::Mat& golden, const cv::Mat& reference,
+                   const json& approved_accuracy, int flip_threads, const std::string& device, bool& flaky) {
+    const StabilitySpec& st = tc.stability;
+    json j;
+    // 1. Determinism: repeats in this instance, and one render with one lavapipe thread.
+    bool deterministic = true;
+    std::string how;
+    for (int k = 1; k < st.repeats; ++k)
+        if (!bit_identical(w.renderer.render(tc.spec).image, base)) {
+            deterministic = false;
+            how = "repeat " + std::to_string(k) + " differs";
+        }
+    if (st.thread_counts && tc.spec.method != "reference" &&
+        !bit_identical(render_single_threaded(tc.spec, device), base)) {
+        deterministic = false;
+        how += (how.empty() ? "" : "; ") + std::string("LP_NUM_THREADS=1 differs");
+    }
+    if (tc.spec.method == "reference") {
+        TestSpec one = tc.spec;
+        one.options.set("threads", "1");
+        if (!bit_identical(w.renderer.render(one).image, base)) {
+            deterministic = false;
+            how += (how.empty() ? "" : "; ") + std::string("threads=1 differs");
+        }
+    }
+    j["deterministic"] = deterministic;
+    if (!deterministic) j["nondeterminism"] = how;
+
+    // 2. Noise floors: Monte Carlo methods over seeds; each metric's spread against the baseline
+    // and the accuracy's spread against the reference golden.
+    std::map<std::string, double> floor;
+    std::vector<cv::Mat> variants;
+    if (monte_carlo(tc.spec))
+        for (int s = 1; s < st.seeds; ++s) {
+            TestSpec seeded = tc.spec;
+            seeded.options.set("seed", std::to_string(tc.spec.options.get_int("seed", 0) + s));
+            variants.push_back(w.renderer.render(seeded).image);
+        }
+    auto spread = [&](const cv::Mat& against, const std::string& prefix) {
+        if (against.empty() || against.size() != base.size()) return;
+        json m0 = compare_images(against, base, flip_threads);
+        for (const cv::Mat& v : variants) {
+            json m = compare_images(against, v, flip_threads);
+            for (const char* k : {"flip.mean", "flip.p99", "flip.block_max", "ssim.mean"}) {
+                double d = std::fabs(metric_value(m, k) - metric_value(m0, k));
+                floor[prefix + k] = std::max(floor[prefix + k], d);
+            }
+            // Against the baseline itself the seed change is the whole difference.
+            if (prefix.empty())
+                for (const char* k : {"flip.mean", "flip.p99", "flip.block_max"})
+                    floor[k] = std::max(floor[k], metric_value(compare_images(base, v, flip_threads), k));
+        }
+    };
+    spread(golden, "");
+    spread(reference, "accuracy.");
+    j["noise_floor"] = floor;
+    j["seeds"] = monte_carlo(tc.spec) ? st.seeds : 1;
+
+    // 3. Sensitivity: what a quarter-pixel camera shift or a 1e-3 roughness change does.
+    json sens;
+    for (auto [key, value] : {std::pair<std::string, std::string>{"camera_shift", fmt::format("{},{},0", st.camera_shift, st.camera_shift)},
+                              std::pair<std::string, std::string>{"roughness_bias", fmt::format("{}", st.roughness_bias)}}) {
+        TestSpec p = tc.spec;
+        p.options.set(key, value);
+        json m = compare_images(base, w.renderer.render(p).image, flip_threads);
+        sens[key] = {{"value", value}, {"flip.mean", m["flip"]["mean"]}, {"flip.p99", m["flip"]["p99"]},
+                     {"flip.block_max", m["flip"]["block_max"]}, {"ssim.mean", m["ssim"]["mean"]}};
+    }
+    j["sensitivity"] = sens;
+
+    // 4. Margins: tolerance / noise floor (null when the floor is 0: a deterministic render).
+    json margins = json::object();
+    flaky = false;
+    auto margin = [&](const std::string& name, double width, double nf) {
+        if (nf <= 0) {
+            margins[name] = nullptr;
+            return;
+        }
+        double m = width / nf;
+        margins[name] = m;
+        if (m < st.min_margin) flaky = true;
+    };
+    for (auto& [metric, bound] : tc.baseline_tolerances) {
+        if (!floor.count(metric)) continue;
+        if (bound.max) margin(metric, *bound.max, floor[metric]);
+        else if (bound.min) margin(metric, 1.0 - *bound.min, floor[metric]);
+    }
+    for (auto& [metric, band] : tc.reference_band) {
+        std::string key = "accuracy." + metric;
+        if (!floor.count(key) || !approved_accuracy.is_object() || !approved_accuracy.contains(metric)) continue;
+        double a = approved_accuracy[metric].get<double>();
+        margin(key, std::min(a * band.below, a * band.above) + band.abs, floor[key]);
+    }
+    j["margins"] = margins;
+    j["min_margin"] = st.min_margin;
+    j["flaky"] = flaky;
+    return j;
+}
+
 // One test: render, compare, decide. Never throws: failures become verdicts.
 json run_test(const TestCase& tc, Worker& w, const GoldenStore& store, const fs::path& out_dir, int flip_threads,
-              bool& shader_error) {
+              bool& shader_error, const std::string& device) {
     json r;
     r["name"] = tc.name;
     r["suite"] = tc.suite;
@@ -244,6 +378,7 @@ json run_test(const TestCase& tc, Worker& w, const GoldenStore& store, const fs:
 
         // 1. Approved baselines: pass against any of them.
         json approved_accuracy;
+        cv::Mat matched_golden, reference_image;
         if (tc.baseline) {
             auto goldens = store.baselines(tc.name);
             if (goldens.empty()) {
@@ -301,6 +436,7 @@ json run_test(const TestCase& tc, Worker& w, const GoldenStore& store, const fs:
                 }
                 if (ok && !passed_one) {
                     passed_one = true;
+                    matched_golden = g.image;
                     best = c;
                     approved_accuracy = g.provenance.value("accuracy", json());
                 } else if (!passed_one && (best.is_null() || !best.contains("metrics") ||
@@ -320,6 +456,7 @@ json run_test(const TestCase& tc, Worker& w, const GoldenStore& store, const fs:
         // 2. Accuracy against the reference golden, checked against the band approved at bless time.
         if (tc.reference) {
             if (auto ref = store.reference(tc.spec)) {
+                reference_image = ref->image;
                 json c;
                 c["kind"] = "reference";
                 c["golden"] = ref->image_path.string();
@@ -374,6 +511,28 @@ json run_test(const TestCase& tc, Worker& w, const GoldenStore& store, const fs:
 
         // 3. Temporal sequences.
         if (tc.temporal.frames > 0) r["temporal"] = run_temporal(tc, w, img_dir, flip_threads, any_fail, problems);
+
+        // 4. Stability: determinism, noise floors, sensitivity, margins.
+        if (tc.stability.enabled) {
+            bool flaky = false;
+            if (matched_golden.empty() && tc.baseline) {
+                auto goldens = store.baselines(tc.name);
+                if (!goldens.empty()) matched_golden = goldens[0].image;
+            }
+            r["stability"] = run_stability(tc, w, rr.image, matched_golden, reference_image, approved_accuracy,
+                                           flip_threads, device, flaky);
+            if (!r["stability"]["deterministic"].get<bool>()) {
+                any_fail = true;
+                problems.push_back("not deterministic: " + r["stability"]["nondeterminism"].get<std::string>());
+            }
+            if (flaky) {
+                std::string which;
+                for (auto& [k, v] : r["stability"]["margins"].items())
+                    if (v.is_number() && v.get<double>() < tc.stability.min_margin) which += fmt::format("{} margin {:.2f}; ", k, v.get<double>());
+                problems.push_back("flaky: tolerance under " + fmt_num(tc.stability.min_margin) + "x its noise floor: " + which);
+                if (tc.stability.fail_on_flaky) any_fail = true;
+            }
+        }
 
         std::string verdict = missing ? "missing-golden" : any_fail ? "fail" : improved ? "improved" : "pass";
         r["verdict"] = verdict;
@@ -480,7 +639,9 @@ RunSummary run_suite(const RunOptions& o) {
         Worker w(o.device);
         for (size_t i; (i = next++) < tests.size();) {
             bool se = false;
-            results[i] = run_test(tests[i], w, store, o.out_dir, flip_threads, se);
+            TestCase tc = tests[i];
+            if (o.stability) tc.stability.enabled = true;
+            results[i] = run_test(tc, w, store, o.out_dir, flip_threads, se, o.device);
             if (se) shader_error = true;
             int n = ++done;
             if (!o.quiet) {

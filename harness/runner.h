@@ -26,6 +26,7 @@ struct RunOptions {
     std::string command_line;           // for the report
     bool quiet = false;
     bool report = true;                 // write index.html when out_dir is set
+    bool stability = false;             // measure determinism, noise floors and margins for every test
 };
 
 struct RunSummary {

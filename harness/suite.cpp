@@ -91,6 +91,20 @@ struct Ctx {
     }
 };
 
+StabilitySpec parse_stability(const Ctx& c, const json& j, const std::string& where, StabilitySpec st) {
+    c.keys(j, where, {"repeats", "seeds", "thread_counts", "roughness_bias", "camera_shift", "min_margin", "fail_on_flaky"});
+    st.enabled = true;
+    if (j.contains("repeats")) st.repeats = int(c.num(j["repeats"], where + ".repeats"));
+    if (j.contains("seeds")) st.seeds = int(c.num(j["seeds"], where + ".seeds"));
+    if (j.contains("thread_counts")) st.thread_counts = c.boolean(j["thread_counts"], where + ".thread_counts");
+    if (j.contains("roughness_bias")) st.roughness_bias = c.num(j["roughness_bias"], where + ".roughness_bias");
+    if (j.contains("camera_shift")) st.camera_shift = c.num(j["camera_shift"], where + ".camera_shift");
+    if (j.contains("min_margin")) st.min_margin = c.num(j["min_margin"], where + ".min_margin");
+    if (j.contains("fail_on_flaky")) st.fail_on_flaky = c.boolean(j["fail_on_flaky"], where + ".fail_on_flaky");
+    if (st.repeats < 1 || st.seeds < 1) c.fail(where, "repeats and seeds must be >= 1");
+    return st;
+}
+
 void parse_size(const Ctx& c, const json& j, const std::string& where, int& w, int& h) {
     std::string s = c.str(j, where);
     if (std::sscanf(s.c_str(), "%dx%d", &w, &h) != 2 || w < 1 || h < 1 || w > 8192 || h > 8192)
@@ -144,7 +158,10 @@ Suite load_suite(const std::string& name_or_path) {
     if (root.contains("description")) suite.description = c.str(root["description"], "description");
 
     json defaults = root.value("defaults", json::object());
-    c.keys(defaults, "defaults", {"env", "size", "jobs", "baseline_tolerances", "reference_band"});
+    c.keys(defaults, "defaults", {"env", "size", "jobs", "baseline_tolerances", "reference_band", "stability"});
+    StabilitySpec default_stability;
+    if (defaults.contains("stability"))
+        default_stability = parse_stability(c, defaults["stability"], "defaults.stability", default_stability);
     std::string default_env = defaults.contains("env") ? c.str(defaults["env"], "defaults.env") : "studio";
     int dw = 0, dh = 0;
     if (defaults.contains("size")) parse_size(c, defaults["size"], "defaults.size", dw, dh);
@@ -162,7 +179,7 @@ Suite load_suite(const std::string& name_or_path) {
         const json& t = root["tests"][i];
         std::string w = "tests[" + std::to_string(i) + "]";
         c.keys(t, w, {"scene", "method", "env", "size", "options", "variants", "baseline", "reference",
-                      "baseline_tolerances", "reference_band", "tags", "temporal"});
+                      "baseline_tolerances", "reference_band", "tags", "temporal", "stability"});
         if (!t.contains("scene")) c.fail(w + ".scene", "missing required key");
         if (!t.contains("method")) c.fail(w + ".method", "missing required key");
         std::vector<std::string> envs;
@@ -197,6 +214,8 @@ Suite load_suite(const std::string& name_or_path) {
         if (t.contains("tags"))
             for (size_t k = 0; k < t["tags"].size(); ++k) proto.tags.push_back(c.str(t["tags"][k], w + ".tags"));
 
+        proto.stability = t.contains("stability") ? parse_stability(c, t["stability"], w + ".stability", default_stability)
+                                                  : default_stability;
         if (t.contains("temporal")) {
             const json& tj = t["temporal"];
             std::string tw = w + ".temporal";

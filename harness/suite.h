@@ -14,7 +14,9 @@
 //                "options": {k: v}, "variants": [{k: v}, ...],
 //                "baseline": true, "reference": true,
 //                "baseline_tolerances": {...}, "reference_band": {...}, "tags": ["..."],
-//                "temporal": {"frames": 32, "reference_ssaa": 8, "checks": {NAME: {"min": x, "max": y}}} } ]
+//                "temporal": {"frames": 32, "reference_ssaa": 8, "checks": {NAME: {"min": x, "max": y}}},
+//                "stability": {"repeats": 2, "seeds": 3, "thread_counts": true, "min_margin": 3,
+//                              "fail_on_flaky": false} } ]       ("stability" may also sit in "defaults")
 // }
 // METRIC is one of flip.mean, flip.p99, flip.block_max, ssim.mean, psnr.db.
 // baseline_tolerances bound the difference to the approved baseline (deterministic renders: tight).
@@ -48,6 +50,20 @@ struct TemporalSpec {
     std::map<std::string, Bound> checks;  // flicker, variation_ratio, flip_mean, flicker_ratio, flip_ratio
 };
 
+// Verdict stability (issue 9): determinism across repeats and lavapipe thread counts, noise floors
+// (Monte Carlo methods: spread over seeds), sensitivity to tiny perturbations, and margins =
+// tolerance / noise floor. A margin under min_margin is `flaky`; with fail_on_flaky it fails.
+struct StabilitySpec {
+    bool enabled = false;
+    int repeats = 2;              // renders compared bit for bit
+    int seeds = 3;                // Monte Carlo methods: seeds 0..seeds-1
+    bool thread_counts = true;    // also render under LP_NUM_THREADS=1
+    double roughness_bias = 1e-3; // sensitivity perturbations
+    double camera_shift = 0.25;   // pixels
+    double min_margin = 3.0;
+    bool fail_on_flaky = false;
+};
+
 struct TestCase {
     std::string name;
     std::string suite;
@@ -59,6 +75,7 @@ struct TestCase {
     std::map<std::string, Band> reference_band;
     std::vector<std::string> tags;
     TemporalSpec temporal;
+    StabilitySpec stability;
 };
 
 struct Suite {

@@ -29,6 +29,8 @@ std::vector<OptionInfo> option_catalog() {
         {"env_rotation", "0", "degrees", "all", "turns the environment about +Y"},
         {"frame", "0", "integer", "all", "frame of an animated scene (bumpy_sphere)"},
         {"bump_amplitude", "0.0008", ">=0", "all", "height of the bumpy_sphere normal detail"},
+        {"roughness_bias", "0", "-1..1", "all", "stability: added to every sphere's roughness"},
+        {"camera_shift", "0", "pixels x,y,0", "all", "stability: moves the camera by a fraction of a pixel"},
         {"bump_frequency", "200", ">0", "all", "spatial frequency of the bumpy_sphere normal detail (radius-1 units)"},
         {"ssaa", "2", "1..16", "mobile,sampled", "n x n rays per pixel (silhouettes)"},
         {"cube_size", "128 (sampled: 256)", "8..2048, power of two", "mobile,sampled", "base size of the cubemaps"},
@@ -71,6 +73,19 @@ void validate_spec(const TestSpec& spec) {
     for (auto& o : option_catalog())
         if (o.methods == "all" || o.methods.find(spec.method) != std::string::npos) known.insert(o.key);
     spec.options.check_known(known, "method " + spec.method);
+    // Enumerated values ("a|b|c" in the catalogue) are checked here too, so a suite file with a
+    // misspelt variant fails when it is loaded, not halfway through a run.
+    for (auto& o : option_catalog()) {
+        if (!spec.options.has(o.key) || o.values.find('|') == std::string::npos || o.values.find("number") != std::string::npos)
+            continue;
+        std::vector<std::string> allowed;
+        size_t start = 0;
+        for (size_t bar; (bar = o.values.find('|', start)) != std::string::npos; start = bar + 1)
+            allowed.push_back(o.values.substr(start, bar - start));
+        allowed.push_back(o.values.substr(start));
+        spec.options.get_choice(o.key, allowed[0], allowed);
+    }
+    build_scene(spec.scene, spec.options);  // unknown scene or bad material option: UsageError
 }
 
 Renderer::Renderer(vk::ContextOptions options) : options_(std::move(options)) {}

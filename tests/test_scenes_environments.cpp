@@ -276,7 +276,8 @@ TEST(Scene, MaterialOptions) {
     bad.set("roughness", "1.5");
     EXPECT_THROW(build_scene("sphere", bad), UsageError);
     EXPECT_EQ(scene_option_keys(), (std::vector<std::string>{"roughness", "metallic", "base_color", "frame",
-                                                              "bump_amplitude", "bump_frequency"}));
+                                                              "bump_amplitude", "bump_frequency", "roughness_bias",
+                                                              "camera_shift"}));
 }
 
 TEST(Scene, BumpySphereMovesItsDetailEachFrame) {

@@ -30,6 +30,9 @@ void register_run_commands(CLI::App& app, int& exit_code) {
     r->add_option("--goldens", goldens, "Golden folder (default: goldens/)");
     r->add_option("--device", run.device, "Vulkan device/driver name substring (default: lavapipe)");
     r->add_flag("--quiet,-q", run.quiet, "No per-test lines");
+    r->add_flag("--stability", run.stability, "Also measure determinism, noise floors, sensitivity and margins");
+    static int repeat = 1;
+    r->add_option("--repeat", repeat, "Run the suite N times; exit 1 if any verdict changes between runs")->check(CLI::Range(1, 100));
     r->callback([&exit_code] {
         parse_shard(shard, run.shard_index, run.shard_count);
         if (const char* gi = std::getenv("GTEST_SHARD_INDEX"); gi && shard.empty()) run.shard_index = std::atoi(gi);
@@ -40,7 +43,29 @@ void register_run_commands(CLI::App& app, int& exit_code) {
         run.history = history;
         run.goldens = goldens;
         run.command_line = invocation();
-        exit_code = run_suite(run).exit_code();
+        RunSummary first = run_suite(run);
+        exit_code = first.exit_code();
+        for (int k = 1; k < repeat; ++k) {
+            RunOptions again = run;
+            again.out_dir.clear();
+            again.junit.clear();
+            again.json.clear();
+            again.history.clear();
+            again.quiet = true;
+            RunSummary next = run_suite(again);
+            int changed = 0;
+            for (size_t i = 0; i < first.results["tests"].size(); ++i) {
+                const auto& a = first.results["tests"][i];
+                const auto& b = next.results["tests"][i];
+                if (a["verdict"] != b["verdict"]) {
+                    ++changed;
+                    fmt::print("verdict changed on run {}: {} {} -> {}\n", k + 1, a["name"].get<std::string>(),
+                               a["verdict"].get<std::string>(), b["verdict"].get<std::string>());
+                }
+            }
+            fmt::print("repeat {}/{}: {} verdict(s) changed\n", k + 1, repeat, changed);
+            if (changed && exit_code == kExitPass) exit_code = kExitRegression;
+        }
     });
 
     static BlessOptions bo;

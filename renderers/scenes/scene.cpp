@@ -6,6 +6,7 @@
 // (that is what they are for); see the catalog descriptions.
 #include "renderers/scenes/scene.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -179,13 +180,44 @@ std::vector<SceneInfo> scene_catalog() {
 }
 
 const std::vector<std::string>& scene_option_keys() {
-    static const std::vector<std::string> keys = {"roughness", "metallic", "base_color", "frame", "bump_amplitude", "bump_frequency"};
+    static const std::vector<std::string> keys = {"roughness", "metallic", "base_color", "frame", "bump_amplitude", "bump_frequency",
+                                                 "roughness_bias", "camera_shift"};
     return keys;
 }
 
+namespace {
+// Small perturbations for the stability analysis (issue 9): every sphere's roughness + bias
+// (clamped to [0, 1]) and the camera moved by a fraction of a pixel of the scene's default size.
+void apply_perturbations(Scene& s, const OptionMap& o) {
+    float bias = float(o.get_double("roughness_bias", 0.0));
+    for (Sphere& sp : s.spheres) sp.material.roughness = std::clamp(sp.material.roughness + bias, 0.0f, 1.0f);
+    Vec3f shift = o.get_vec3("camera_shift", {0, 0, 0}); // pixels: "x,y,0" or one value for x and y
+    if (shift.x == 0 && shift.y == 0) return;
+    // Pixel size in world units at the scene's default size (orthographic: 2·half_height/height).
+    Camera& c = s.camera;
+    float px = 2.0f * c.half_height / float(s.height);
+    if (!c.orthographic) px = 2.0f * std::tan(c.fov_y_deg * 3.14159265f / 360.0f) * 5.0f / float(s.height);
+    Vec3f f{c.target.x - c.eye.x, c.target.y - c.eye.y, c.target.z - c.eye.z};
+    float fl = std::sqrt(f.x * f.x + f.y * f.y + f.z * f.z);
+    f = {f.x / fl, f.y / fl, f.z / fl};
+    Vec3f r{f.y * c.world_up.z - f.z * c.world_up.y, f.z * c.world_up.x - f.x * c.world_up.z, f.x * c.world_up.y - f.y * c.world_up.x};
+    float rl = std::sqrt(r.x * r.x + r.y * r.y + r.z * r.z);
+    r = {r.x / rl, r.y / rl, r.z / rl};
+    Vec3f u{r.y * f.z - r.z * f.y, r.z * f.x - r.x * f.z, r.x * f.y - r.y * f.x};
+    // +x moves the image content left by `shift.x` pixels: the camera moves right; +y moves it up.
+    Vec3f d{(r.x * shift.x - u.x * shift.y) * px, (r.y * shift.x - u.y * shift.y) * px, (r.z * shift.x - u.z * shift.y) * px};
+    c.eye = {c.eye.x + d.x, c.eye.y + d.y, c.eye.z + d.z};
+    c.target = {c.target.x + d.x, c.target.y + d.y, c.target.z + d.z};
+}
+} // namespace
+
 Scene build_scene(const std::string& name, const OptionMap& options) {
     for (const auto& d : defs())
-        if (name == d.name) return d.build(options);
+        if (name == d.name) {
+            Scene s = d.build(options);
+            apply_perturbations(s, options);
+            return s;
+        }
     std::string valid;
     for (const auto& d : defs()) valid += (valid.empty() ? "" : ", ") + std::string(d.name);
     throw UsageError("unknown scene '" + name + "'; valid scenes: " + valid);

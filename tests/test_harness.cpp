@@ -1,0 +1,266 @@
+// The harness (issue 6): suite schema errors, shards, bless/missing-golden/improved/alternate
+// baselines on a private golden folder, JUnit, and the gate: a deliberate shader change makes the
+// `ci` suite fail on exactly the tests it affects, `iblcheck bisect` follows git bisect's contract.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sys/wait.h>
+
+#include "harness/common/errors.h"
+#include "harness/golden_store.h"
+#include "harness/runner.h"
+#include "harness/suite.h"
+
+namespace fs = std::filesystem;
+using namespace iblcheck;
+using nlohmann::json;
+
+namespace {
+
+fs::path temp_dir(const std::string& name) {
+    fs::path p = fs::temp_directory_path() / ("iblcheck_harness_" + name + "_" + std::to_string(::getpid()));
+    fs::remove_all(p);
+    fs::create_directories(p);
+    return p;
+}
+
+void write_file(const fs::path& p, const std::string& text) {
+    fs::create_directories(p.parent_path());
+    std::ofstream(p) << text;
+}
+
+int run_command(const std::string& cmd, std::string& out) {
+    FILE* pipe = popen((cmd + " 2>&1").c_str(), "r");
+    std::array<char, 512> buf;
+    out.clear();
+    while (fgets(buf.data(), buf.size(), pipe)) out += buf.data();
+    int status = pclose(pipe);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+std::string iblcheck_bin() { return std::string(IBLCHECK_BINARY_DIR) + "/iblcheck"; }
+
+std::string error_of(const fs::path& suite) {
+    try {
+        load_suite(suite.string());
+    } catch (const InputError& e) {
+        return e.what();
+    }
+    return "";
+}
+
+// A small suite of fast tests (furnace scenes) for the bless/verdict cycle.
+const char* kMiniSuite = R"({
+  "suite": "mini",
+  "defaults": {"env": "constant:1",
+               "baseline_tolerances": {"flip.mean": {"max": 0.001}, "ssim.mean": {"min": 0.999}},
+               "reference_band": {"flip.mean": {"below": 0.2, "above": 0.1, "abs": 0.0}}},
+  "tests": [{"scene": "furnace", "method": "mobile", "variants": [{}, {"env_brdf": "lut"}]}]
+})";
+
+} // namespace
+
+TEST(Suite, SchemaErrorsNameFileKeyAndProblem) {
+    fs::path dir = temp_dir("schema");
+    struct Case {
+        std::string text, expect;
+    } cases[] = {
+        {"{ not json", "not valid JSON"},
+        {R"({"suite": "x"})", "tests: missing required key"},
+        {R"({"suite": "x", "tests": [{"scene": "sphere"}]})", "tests[0].method: missing required key"},
+        {R"({"suite": "x", "tests": [{"scene": "sphere", "method": "mobile", "colour": 1}]})", "tests[0].colour: unknown key"},
+        {R"({"suite": "x", "tests": [{"scene": "nope", "method": "mobile"}]})", "unknown scene 'nope'"},
+        {R"({"suite": "x", "tests": [{"scene": "sphere", "method": "mobile", "options": {"mip_mapping": "bogus"}}]})",
+         "mip_mapping"},
+        {R"({"suite": "x", "tests": [{"scene": "sphere", "method": "mobile", "options": {"no_such": 1}}]})",
+         "unknown option(s) for method mobile: no_such"},
+        {R"({"suite": "x", "tests": [{"scene": "sphere", "method": "mobile", "baseline_tolerances": {"flip.mean": {"maximum": 1}}}]})",
+         "tests[0].baseline_tolerances.flip.mean.maximum: unknown key"},
+        {R"({"suite": "x", "tests": [{"scene": "sphere", "method": "mobile", "size": "big"}]})", "tests[0].size: 'big' is not WxH"},
+        {R"({"suite": "x", "tests": [{"scene": "sphere", "method": "mobile"}, {"scene": "sphere", "method": "mobile"}]})",
+         "duplicate test name"},
+    };
+    int i = 0;
+    for (const auto& c : cases) {
+        fs::path f = dir / ("s" + std::to_string(i++) + ".json");
+        write_file(f, c.text);
+        std::string err = error_of(f);
+        EXPECT_NE(err.find(f.string()), std::string::npos) << err;
+        EXPECT_NE(err.find(c.expect), std::string::npos) << "expected '" << c.expect << "' in: " << err << " (case " << i << ")";
+    }
+    EXPECT_NE(error_of(dir / "absent.json").find("no such suite"), std::string::npos);
+    fs::remove_all(dir);
+}
+
+TEST(Suite, ShippedSuitesLoadAndExpand) {
+    Suite ci = load_suite("ci");
+    EXPECT_GE(ci.tests.size(), 30u);
+    std::set<std::string> scenes;
+    for (auto& t : ci.tests) scenes.insert(t.spec.scene);
+    for (const char* s : {"sphere", "roughness_sweep", "furnace", "furnace_dielectric", "grazing"}) EXPECT_TRUE(scenes.count(s)) << s;
+    for (const char* name : {"nightly", "temporal", "stability"}) EXPECT_NO_THROW(load_suite(name)) << name;
+}
+
+TEST(Suite, ShardsPartitionTheSuite) {
+    Suite ci = load_suite("ci");
+    std::multiset<std::string> seen;
+    for (int i = 0; i < 3; ++i)
+        for (auto& t : select_tests(ci, "", i, 3)) seen.insert(t.name);
+    EXPECT_EQ(seen.size(), ci.tests.size());
+    for (auto& t : ci.tests) EXPECT_EQ(seen.count(t.name), 1u) << t.name;
+    EXPECT_EQ(select_tests(ci, "mobile.furnace.*", 0, 1).size(), 2u);
+    EXPECT_THROW(select_tests(ci, "", 3, 3), UsageError);
+}
+
+TEST(Harness, MissingGoldenThenBlessThenPassThenImproved) {
+    fs::path dir = temp_dir("cycle");
+    write_file(dir / "mini.json", kMiniSuite);
+    fs::path goldens = dir / "goldens";
+    fs::create_directories(goldens / "reference");
+    // A reference golden for the furnace: the test's accuracy is measured against it.
+    for (const char* ext : {".exr", ".json"})
+        fs::copy(fs::path(IBLCHECK_SOURCE_DIR) / (std::string("goldens/reference/furnace__constant-1") + ext), goldens / "reference");
+
+    RunOptions o;
+    o.suite = (dir / "mini.json").string();
+    o.goldens = goldens;
+    o.quiet = true;
+    o.out_dir = dir / "out1";
+    RunSummary s1 = run_suite(o);
+    EXPECT_EQ(s1.missing, 2);
+    EXPECT_EQ(s1.exit_code(), kExitRegression);
+    std::string msg = s1.results["tests"][0]["message"];
+    EXPECT_NE(msg.find("iblcheck bless --suite mini --filter 'mobile.furnace.constant:1.default'"), std::string::npos) << msg;
+
+    BlessOptions b;
+    b.suite = o.suite;
+    b.goldens = goldens;
+    EXPECT_EQ(bless(b), kExitPass);
+    fs::path golden = GoldenStore(goldens).baseline_path("mobile.furnace.constant:1.default");
+    ASSERT_TRUE(fs::exists(golden));
+    std::ifstream side(fs::path(golden).replace_extension(".json"));
+    json prov = json::parse(side);
+    for (const char* key : {"scene", "options", "shader_tree_hash", "driver", "cpu_features", "commit", "date", "command",
+                            "env_hash", "accuracy"})
+        EXPECT_TRUE(prov.contains(key)) << key;
+    EXPECT_EQ(prov["driver"]["driver"], "llvmpipe");
+    EXPECT_TRUE(prov["accuracy"].contains("flip.mean"));
+    for (auto& e : fs::directory_iterator(golden.parent_path()))
+        EXPECT_EQ(e.path().string().find(".tmp"), std::string::npos) << "leftover " << e.path();
+
+    o.out_dir = dir / "out2";
+    o.junit = dir / "junit.xml";
+    RunSummary s2 = run_suite(o);
+    EXPECT_EQ(s2.pass, 2) << s2.results.dump(1).substr(0, 2000);
+    EXPECT_EQ(s2.exit_code(), kExitPass);
+    EXPECT_TRUE(fs::exists(dir / "out2/results.json"));
+    EXPECT_TRUE(fs::exists(dir / "out2/index.html"));
+
+    // Pretend the approved accuracy was much worse: the same render is now better than the band's
+    // lower bound, which is `improved` (tighten by re-blessing), not a silent pass.
+    prov["accuracy"]["flip.mean"] = prov["accuracy"]["flip.mean"].get<double>() * 3 + 0.01;
+    std::ofstream(fs::path(golden).replace_extension(".json")) << prov.dump(2);
+    RunSummary s3 = run_suite(o);
+    EXPECT_EQ(s3.improved, 1);
+    EXPECT_EQ(s3.exit_code(), kExitPass);
+    for (auto& t : s3.results["tests"])
+        if (t["verdict"] == "improved") EXPECT_NE(t["message"].get<std::string>().find("tighten"), std::string::npos);
+
+    // A second approved baseline (@label) is accepted when the primary no longer matches.
+    cv::Mat img = GoldenStore(goldens).baselines("mobile.furnace.constant:1.default")[0].image.clone();
+    GoldenStore::write_golden(GoldenStore(goldens).baseline_path("mobile.furnace.constant:1.default", "other-platform"),
+                              img, prov);
+    img.setTo(cv::Scalar(0.2, 0.2, 0.2));
+    GoldenStore::write_golden(golden, img, prov);
+    RunSummary s4 = run_suite(o);
+    for (auto& t : s4.results["tests"])
+        if (t["name"] == "mobile.furnace.constant:1.default") {
+            EXPECT_EQ(t["verdict"], "improved");  // passes the @other-platform baseline; accuracy as above
+            EXPECT_EQ(t["comparisons"][0]["label"], "other-platform");
+        }
+    fs::remove_all(dir);
+}
+
+TEST(Harness, JUnitIsWellFormedAndCountsFailures) {
+    json results = {{"suite", "s"}, {"total_s", 1.5}, {"started", "2026-01-01T00:00:00Z"},
+                    {"tests", json::array({{{"name", "a<b"}, {"method", "mobile"}, {"verdict", "pass"}, {"wall_s", 0.1}},
+                                           {{"name", "c&d"}, {"method", "mobile"}, {"verdict", "fail"}, {"message", "flip \"x\""},
+                                            {"bless_command", "iblcheck bless --filter 'c&d'"}},
+                                           {{"name", "e"}, {"verdict", "missing-golden"}, {"message", "m"}},
+                                           {{"name", "f"}, {"verdict", "error"}, {"message", "boom"}}})}};
+    fs::path dir = temp_dir("junit");
+    write_junit(results, dir / "j.xml");
+    // Validate with Python's XML parser (stdlib): well-formed, and the counts add up.
+    std::string out;
+    int rc = run_command("python3 -c \"import sys, xml.etree.ElementTree as E; r = E.parse(sys.argv[1]).getroot(); "
+                         "s = r.find('testsuite'); c = s.findall('testcase'); "
+                         "print(r.tag, s.get('tests'), s.get('failures'), s.get('errors'), len(c), "
+                         "len([x for x in c if x.find('failure') is not None]), len([x for x in c if x.find('error') is not None]), "
+                         "c[0].get('name'))\" " + (dir / "j.xml").string(),
+                         out);
+    if (rc == 127) GTEST_SKIP() << "python3 not found: cannot validate the XML";
+    EXPECT_EQ(rc, 0) << out;
+    EXPECT_EQ(out, "testsuites 4 2 1 4 2 1 a<b\n");
+    fs::remove_all(dir);
+}
+
+TEST(Gate, ShaderChangeFailsExactlyTheAffectedCiTestsAndBisectFollowsTheContract) {
+    // A perturbed EnvBRDFApprox constant (c1.w −0.04 → −0.03) in a copy of the shaders: every mobile
+    // test that uses env_brdf=approx must fail, the LUT and sampled tests must pass.
+    fs::path dir = temp_dir("gate");
+    fs::copy(fs::path(IBLCHECK_SOURCE_DIR) / "renderers/shaders", dir / "shaders", fs::copy_options::recursive);
+    fs::path f = dir / "shaders/env_brdf.glsl";
+    std::string text;
+    {
+        std::ifstream in(f);
+        text.assign(std::istreambuf_iterator<char>(in), {});
+    }
+    const std::string from = "vec4(1.0, 0.0425, 1.04, -0.04)";
+    ASSERT_NE(text.find(from), std::string::npos);
+    text.replace(text.find(from), from.size(), "vec4(1.0, 0.0425, 1.04, -0.03)");
+    write_file(f, text);
+    std::string env = "IBLCHECK_CACHE_DIR=" + dir.string() + " IBLCHECK_SHADER_DIR=" + (dir / "shaders").string() + " ";
+    std::string out;
+    int rc = run_command(env + iblcheck_bin() + " run --suite ci -q --json " + (dir / "bad.json").string(), out);
+    EXPECT_EQ(rc, 1) << out;
+    std::ifstream in(dir / "bad.json");
+    json r = json::parse(in);
+    int failed = 0;
+    for (auto& t : r["tests"]) {
+        std::string name = t["name"];
+        bool approx = t["method"] == "mobile" && name.find("env_brdf=lut") == std::string::npos;
+        EXPECT_EQ(t["verdict"], approx ? "fail" : "pass") << name << ": " << t["message"];
+        failed += t["verdict"] == "fail";
+        if (approx) EXPECT_NE(t["message"].get<std::string>().find("worst 16x16 block at"), std::string::npos);
+    }
+    EXPECT_GE(failed, 20);
+
+    // Without the change the suite passes again.
+    rc = run_command(iblcheck_bin() + " run --suite ci -q", out);
+    EXPECT_EQ(rc, 0) << out;
+
+    // git bisect run: 0 good, 1 bad, 125 when the shaders do not compile.
+    const std::string filter = " bisect --filter 'mobile.roughness_sweep.studio.default'";
+    EXPECT_EQ(run_command(iblcheck_bin() + filter, out), 0) << out;
+    EXPECT_EQ(run_command(env + iblcheck_bin() + filter, out), 1) << out;
+    std::ofstream(f, std::ios::app) << "\nnot glsl at all;\n";
+    EXPECT_EQ(run_command(env + iblcheck_bin() + filter, out), 125) << out;
+    fs::remove_all(dir);
+}
+
+TEST(Cli, BadInputExitsTwo) {
+    std::string out;
+    EXPECT_EQ(run_command(iblcheck_bin() + " run --suite no_such_suite", out), 2);
+    EXPECT_NE(out.find("no such suite"), std::string::npos) << out;
+    EXPECT_EQ(run_command(iblcheck_bin() + " render --scene nope", out), 2);
+    EXPECT_NE(out.find("valid scenes"), std::string::npos) << out;
+    EXPECT_EQ(run_command(iblcheck_bin() + " render --scene sphere --set roughness=abc", out), 2);
+    EXPECT_NE(out.find("roughness"), std::string::npos) << out;
+    EXPECT_EQ(run_command(iblcheck_bin() + " render --scene sphere --env /nonexistent.exr", out), 2);
+    EXPECT_NE(out.find("/nonexistent.exr"), std::string::npos) << out;
+    EXPECT_EQ(run_command(iblcheck_bin() + " run --suite ci --filter 'nothing*'", out), 2);
+}
