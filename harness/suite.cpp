@@ -65,6 +65,10 @@ struct Ctx {
         keys(j, where, kMetrics);
         for (auto& [metric, b] : j.items()) {
             std::string w = where + "." + metric;
+            if (b.is_null()) {  // null drops a suite default: the metric is not checked for this test
+                out[metric] = Bound{};
+                continue;
+            }
             keys(b, w, {"min", "max"});
             Bound bound;
             if (b.contains("min")) bound.min = num(b["min"], w + ".min");
@@ -110,8 +114,6 @@ void parse_size(const Ctx& c, const json& j, const std::string& where, int& w, i
     if (std::sscanf(s.c_str(), "%dx%d", &w, &h) != 2 || w < 1 || h < 1 || w > 8192 || h > 8192)
         c.fail(where, "'" + s + "' is not WxH");
 }
-
-std::string sanitize_env(const std::string& env) { return env; }
 
 } // namespace
 
@@ -207,7 +209,10 @@ Suite load_suite(const std::string& name_or_path) {
         if (t.contains("reference")) proto.reference = c.boolean(t["reference"], w + ".reference");
         proto.baseline_tolerances = default_bounds;
         if (t.contains("baseline_tolerances"))
-            for (auto& [k, v] : c.bounds(t["baseline_tolerances"], w + ".baseline_tolerances")) proto.baseline_tolerances[k] = v;
+            for (auto& [k, v] : c.bounds(t["baseline_tolerances"], w + ".baseline_tolerances")) {
+                if (v.min || v.max) proto.baseline_tolerances[k] = v;
+                else proto.baseline_tolerances.erase(k);
+            }
         proto.reference_band = default_bands;
         if (t.contains("reference_band"))
             for (auto& [k, v] : c.bands(t["reference_band"], w + ".reference_band")) proto.reference_band[k] = v;
@@ -243,8 +248,10 @@ Suite load_suite(const std::string& name_or_path) {
                 tc.spec.env = env;
                 tc.spec.options = base_opts;
                 for (auto& [k, v] : variant.values()) tc.spec.options.set(k, v);
-                tc.variant = variant.values().empty() ? "default" : variant.canonical();
-                tc.name = tc.spec.method + "." + tc.spec.scene + "." + sanitize_env(env) + "." + tc.variant;
+                // Every option is in the name (not only the variant's), so two suites testing different
+                // configurations never share a name, and so never a baseline golden.
+                tc.variant = tc.spec.options.values().empty() ? "default" : tc.spec.options.canonical();
+                tc.name = tc.spec.method + "." + tc.spec.scene + "." + env + "." + tc.variant;
                 try {
                     validate_spec(tc.spec);
                 } catch (const UsageError& e) {

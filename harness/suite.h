@@ -1,7 +1,7 @@
 // Suites are data: harness/suites/<name>.json, one schema, validated with errors that name the
 // file, the key and the problem. A suite expands into TestCases: each entry may list several
 // environments and variants, and every combination is one test named
-//   <method>.<scene>.<env>.<variant>      (variant: "k=v,k=v" of the variant's options, or "default")
+//   <method>.<scene>.<env>.<options>      (options: "k=v,k=v" of all the test's options, or "default")
 //
 // Schema (keys marked * are required):
 // {
@@ -18,7 +18,8 @@
 //                "stability": {"repeats": 2, "seeds": 3, "thread_counts": true, "min_margin": 3,
 //                              "fail_on_flaky": false} } ]       ("stability" may also sit in "defaults")
 // }
-// METRIC is one of flip.mean, flip.p99, flip.block_max, ssim.mean, psnr.db.
+// METRIC is one of flip.mean, flip.p99, flip.block_max, ssim.mean, psnr.db; in a test, METRIC: null
+// drops a suite default (e.g. a percentile that seed noise alone saturates).
 // baseline_tolerances bound the difference to the approved baseline (deterministic renders: tight).
 // reference_band bounds the accuracy against the ground truth around the value approved at bless
 // time: [v·(1 − below) − abs, v·(1 + above) + abs]; under the band is `improved`, over it `fail`.
@@ -67,7 +68,7 @@ struct StabilitySpec {
 struct TestCase {
     std::string name;
     std::string suite;
-    std::string variant;             // "default" or canonical k=v list of the variant options
+    std::string variant;             // "default" or the canonical k=v list of all the test's options
     TestSpec spec;
     bool baseline = true;            // compare with approved baselines
     bool reference = true;           // measure accuracy against the reference golden if one exists

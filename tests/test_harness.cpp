@@ -264,3 +264,40 @@ TEST(Cli, BadInputExitsTwo) {
     EXPECT_NE(out.find("/nonexistent.exr"), std::string::npos) << out;
     EXPECT_EQ(run_command(iblcheck_bin() + " run --suite ci --filter 'nothing*'", out), 2);
 }
+
+TEST(Suites, TemporalAndStabilitySuitesPass) {
+    // issue 7 and issue 9: the shipped suites pass on lavapipe (bands, claims, margins, determinism).
+    std::string out;
+    EXPECT_EQ(run_command(iblcheck_bin() + " run --suite temporal", out), 0) << out;
+    EXPECT_EQ(run_command(iblcheck_bin() + " run --suite stability", out), 0) << out;
+    EXPECT_NE(out.find("0 fail"), std::string::npos) << out;
+}
+
+TEST(Temporal, BrokenSpecularAntiAliasingFailsTheGate) {
+    // The toksvig-under-the-sun entry of the temporal suite with its variance scale at 0 (the AA
+    // does nothing): its flicker ratio becomes 1, above the claimed 0.7, and the test fails.
+    Suite shipped = load_suite("temporal");
+    const TestCase* claim = nullptr;
+    for (auto& t : shipped.tests)
+        if (t.spec.env == "sky_sun" && t.spec.options.get_string("specular_aa", "") == "toksvig") claim = &t;
+    ASSERT_NE(claim, nullptr);
+    ASSERT_TRUE(claim->temporal.checks.count("flicker_ratio"));
+    json suite = {{"suite", "temporal_broken"},
+                  {"tests", json::array({{{"scene", "bumpy_sphere"}, {"method", "mobile"}, {"env", "sky_sun"},
+                                          {"baseline", false}, {"reference", false},
+                                          {"options", {{"ssaa", 1}, {"specular_aa", "toksvig"}, {"specular_aa_variance", 0}}},
+                                          {"temporal", {{"frames", claim->temporal.frames},
+                                                        {"checks", {{"flicker_ratio", {{"max", *claim->temporal.checks.at("flicker_ratio").max}}}}}}}}})}};
+    fs::path dir = temp_dir("temporal_broken");
+    write_file(dir / "broken.json", suite.dump());
+    RunOptions o;
+    o.suite = (dir / "broken.json").string();
+    o.quiet = true;
+    RunSummary s = run_suite(o);
+    ASSERT_EQ(s.results["tests"].size(), 1u);
+    const json& t = s.results["tests"][0];
+    EXPECT_EQ(t["verdict"], "fail") << t.dump(1);
+    EXPECT_NEAR(t["temporal"]["flicker_ratio"].get<double>(), 1.0, 1e-9);
+    EXPECT_NE(t["message"].get<std::string>().find("flicker_ratio"), std::string::npos);
+    fs::remove_all(dir);
+}

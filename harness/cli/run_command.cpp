@@ -4,6 +4,7 @@
 #include "commands.h"
 #include "harness/common/errors.h"
 #include "harness/runner.h"
+#include "harness/suite.h"
 
 namespace iblcheck::cli {
 
@@ -30,6 +31,8 @@ void register_run_commands(CLI::App& app, int& exit_code) {
     r->add_option("--goldens", goldens, "Golden folder (default: goldens/)");
     r->add_option("--device", run.device, "Vulkan device/driver name substring (default: lavapipe)");
     r->add_flag("--quiet,-q", run.quiet, "No per-test lines");
+    static bool list_only = false;
+    r->add_flag("--list", list_only, "Print the selected tests' names and exit");
     r->add_flag("--stability", run.stability, "Also measure determinism, noise floors, sensitivity and margins");
     static int repeat = 1;
     r->add_option("--repeat", repeat, "Run the suite N times; exit 1 if any verdict changes between runs")->check(CLI::Range(1, 100));
@@ -43,6 +46,12 @@ void register_run_commands(CLI::App& app, int& exit_code) {
         run.history = history;
         run.goldens = goldens;
         run.command_line = invocation();
+        if (list_only) {
+            for (const auto& t : select_tests(load_suite(run.suite), run.filter, run.shard_index, run.shard_count))
+                fmt::print("{}\n", t.name);
+            exit_code = kExitPass;
+            return;
+        }
         RunSummary first = run_suite(run);
         exit_code = first.exit_code();
         for (int k = 1; k < repeat; ++k) {

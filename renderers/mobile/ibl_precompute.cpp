@@ -100,15 +100,21 @@ IblResources run_precompute(GpuSession& gpu, const Environment& env, const Preco
             ctx.transition(cmd, *img, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL);
 
         // 1. equirect → cube, supersampled so each cube texel averages the equirect pixels it covers.
-        timer.begin(cmd, "equirect_to_cube");
         struct { uint32_t size, ss; float rot; } pe{s.cube_size, std::max(1u, (ew + 4 * s.cube_size - 1) / (4 * s.cube_size)),
                                                     s.env_rotation_deg};
-        p_e2c.dispatch(cmd, {vk::Binding::sampled_image(0, equirect.sampled_view, ctx.equirect_sampler()),
-                             vk::Binding::storage_image(1, r.source_cube.storage_views[0])},
-                       &pe, sizeof pe, groups(s.cube_size), groups(s.cube_size), 6);
+        std::vector<vk::Binding> be = {vk::Binding::sampled_image(0, equirect.sampled_view, ctx.equirect_sampler()),
+                                       vk::Binding::storage_image(1, r.source_cube.storage_views[0])};
+        p_e2c.warm_up(cmd, be, &pe, sizeof pe);
+        timer.begin(cmd, "equirect_to_cube");
+        p_e2c.dispatch(cmd, be, &pe, sizeof pe, groups(s.cube_size), groups(s.cube_size), 6);
         timer.end(cmd);
         ctx.barrier(cmd);
 
+        if (r.full_mips > 1) {
+            uint32_t size1 = std::max(1u, s.cube_size >> 1);
+            p_down.warm_up(cmd, {vk::Binding::storage_image(0, r.source_cube.storage_views[0]),
+                                 vk::Binding::storage_image(1, r.source_cube.storage_views[1])}, &size1, 4);
+        }
         timer.begin(cmd, "downsample_cube");
         for (uint32_t m = 1; m < r.full_mips; ++m) {
             uint32_t size = std::max(1u, s.cube_size >> m);
@@ -120,8 +126,15 @@ IblResources run_precompute(GpuSession& gpu, const Environment& env, const Preco
         timer.end(cmd);
 
         if (s.prefiltered) {
-            timer.begin(cmd, "prefilter_ggx");
             for (uint32_t m = 0; m < mips; ++m) {
+                if (m == 0) {  // warm-up: a mip-0 copy of one workgroup, overwritten below
+                    struct { uint32_t mip, dst_size, src_size, samples; float full_mips, max_lod, src_max_lod; } pw{
+                        0, s.cube_size, s.cube_size, s.prefilter_samples, float(r.full_mips), float(mips - 1),
+                        float(r.full_mips - 1)};
+                    p_pre.warm_up(cmd, {vk::Binding::sampled_image(0, r.source_cube.sampled_view, ctx.linear_sampler()),
+                                        vk::Binding::storage_image(1, r.prefiltered.storage_views[0])}, &pw, sizeof pw);
+                    timer.begin(cmd, "prefilter_ggx");
+                }
                 struct { uint32_t mip, dst_size, src_size, samples; float full_mips, max_lod, src_max_lod; } pp{
                     m, std::max(1u, s.cube_size >> m), s.cube_size, s.prefilter_samples, float(r.full_mips),
                     float(mips - 1), float(r.full_mips - 1)};
@@ -136,16 +149,18 @@ IblResources run_precompute(GpuSession& gpu, const Environment& env, const Preco
         // SH9 from a 32² level (or the base if smaller): enough for 9 coefficients, and exact weights.
         uint32_t sh_mip = s.cube_size > 32 ? uint32_t(std::log2(double(s.cube_size / 32))) : 0;
         uint32_t sh_size = s.cube_size >> sh_mip;
+        std::vector<vk::Binding> bsh = {vk::Binding::storage_image(0, r.source_cube.storage_views[sh_mip]),
+                                        vk::Binding::storage_buffer(1, r.sh)};
+        p_sh.warm_up(cmd, bsh, &sh_size, 4);
         timer.begin(cmd, "sh9_project");
-        p_sh.dispatch(cmd, {vk::Binding::storage_image(0, r.source_cube.storage_views[sh_mip]),
-                            vk::Binding::storage_buffer(1, r.sh)},
-                      &sh_size, 4, 1);
+        p_sh.dispatch(cmd, bsh, &sh_size, 4, 1);
         timer.end(cmd);
 
         if (s.lut) {
             const auto& p_lut = gpu.pipeline("dfg_lut.comp", {}, {kStorageImage}, 8);
-            timer.begin(cmd, "dfg_lut");
             uint32_t pl[2] = {s.lut_size, s.lut_samples};
+            p_lut.warm_up(cmd, {vk::Binding::storage_image(0, r.lut.storage_views[0])}, pl, 8);
+            timer.begin(cmd, "dfg_lut");
             p_lut.dispatch(cmd, {vk::Binding::storage_image(0, r.lut.storage_views[0])}, pl, 8, groups(s.lut_size),
                            groups(s.lut_size), 1);
             timer.end(cmd);
@@ -154,10 +169,11 @@ IblResources run_precompute(GpuSession& gpu, const Environment& env, const Preco
             const auto& p_irr = gpu.pipeline("irradiance_cube.comp", {}, {kStorageImage, kStorageImage}, 8);
             uint32_t src_mip = s.cube_size > 16 ? uint32_t(std::log2(double(s.cube_size / 16))) : 0;
             uint32_t pi[2] = {s.irradiance_size, s.cube_size >> src_mip};
+            std::vector<vk::Binding> bi = {vk::Binding::storage_image(0, r.source_cube.storage_views[src_mip]),
+                                           vk::Binding::storage_image(1, r.irradiance.storage_views[0])};
+            p_irr.warm_up(cmd, bi, pi, 8);
             timer.begin(cmd, "irradiance_cube");
-            p_irr.dispatch(cmd, {vk::Binding::storage_image(0, r.source_cube.storage_views[src_mip]),
-                                 vk::Binding::storage_image(1, r.irradiance.storage_views[0])},
-                           pi, 8, groups(s.irradiance_size), groups(s.irradiance_size), 6);
+            p_irr.dispatch(cmd, bi, pi, 8, groups(s.irradiance_size), groups(s.irradiance_size), 6);
             timer.end(cmd);
         }
         ctx.barrier(cmd);

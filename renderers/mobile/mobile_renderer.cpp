@@ -89,15 +89,15 @@ RenderResult render_mobile(GpuSession& gpu, const Environment& env, const TestSp
     vk::GpuTimer timer(ctx, 1);
     ctx.submit([&](VkCommandBuffer cmd) {
         timer.reset(cmd);
+        std::vector<vk::Binding> b = {vk::Binding::storage_buffer(0, scene_buf),
+                                      vk::Binding::sampled_image(1, ibl.prefiltered.sampled_view, ctx.linear_sampler()),
+                                      vk::Binding::storage_buffer(2, ibl.sh),
+                                      vk::Binding::sampled_image(3, ibl.lut.sampled_view, ctx.linear_sampler()),
+                                      vk::Binding::sampled_image(4, ibl.irradiance.sampled_view, ctx.linear_sampler()),
+                                      vk::Binding::storage_buffer(5, out)};
+        shade.warm_up(cmd, b, &pc, sizeof pc);
         timer.begin(cmd, "shade_spheres");
-        shade.dispatch(cmd,
-                       {vk::Binding::storage_buffer(0, scene_buf),
-                        vk::Binding::sampled_image(1, ibl.prefiltered.sampled_view, ctx.linear_sampler()),
-                        vk::Binding::storage_buffer(2, ibl.sh),
-                        vk::Binding::sampled_image(3, ibl.lut.sampled_view, ctx.linear_sampler()),
-                        vk::Binding::sampled_image(4, ibl.irradiance.sampled_view, ctx.linear_sampler()),
-                        vk::Binding::storage_buffer(5, out)},
-                       &pc, sizeof pc, (width + 7) / 8, (height + 7) / 8, 1);
+        shade.dispatch(cmd, b, &pc, sizeof pc, (width + 7) / 8, (height + 7) / 8, 1);
         timer.end(cmd);
         ctx.barrier(cmd);
     });

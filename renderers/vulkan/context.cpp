@@ -613,6 +613,14 @@ void ComputePipeline::dispatch(VkCommandBuffer cmd, const std::vector<Binding>& 
     vkCmdDispatch(cmd, gx, gy, gz);
 }
 
+void ComputePipeline::warm_up(VkCommandBuffer cmd, const std::vector<Binding>& bindings, const void* push,
+                              uint32_t push_bytes) const {
+    if (warmed_) return;
+    warmed_ = true;
+    dispatch(cmd, bindings, push, push_bytes, 1, 1, 1);
+    Context::barrier(cmd);
+}
+
 GpuTimer::GpuTimer(Context& ctx, uint32_t max_passes) : ctx_(ctx), max_(max_passes) {
     VkQueryPoolCreateInfo qi{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
     qi.queryType = VK_QUERY_TYPE_TIMESTAMP;

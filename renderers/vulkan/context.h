@@ -108,6 +108,11 @@ class ComputePipeline {
     ComputePipeline(const ComputePipeline&) = delete;
     ComputePipeline& operator=(const ComputePipeline&) = delete;
 
+    // llvmpipe compiles a shader variant at its first dispatch, not at pipeline creation: call this
+    // before a timed region to record one untimed single-workgroup dispatch (once per pipeline), so
+    // timestamps measure execution only. Its writes are overwritten by the real dispatch.
+    void warm_up(VkCommandBuffer cmd, const std::vector<Binding>& bindings, const void* push, uint32_t push_bytes) const;
+
     // Records bind + push descriptors + push constants + dispatch.
     void dispatch(VkCommandBuffer cmd, const std::vector<Binding>& bindings, const void* push, uint32_t push_bytes,
                   uint32_t gx, uint32_t gy = 1, uint32_t gz = 1) const;
@@ -118,6 +123,7 @@ class ComputePipeline {
     VkPipelineLayout layout_ = VK_NULL_HANDLE;
     VkPipeline pipeline_ = VK_NULL_HANDLE;
     uint32_t push_bytes_ = 0;
+    mutable bool warmed_ = false;
 };
 
 // Timestamp queries around passes. begin(name)/end() pairs in one command buffer; results after

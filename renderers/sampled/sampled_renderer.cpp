@@ -1,9 +1,9 @@
 // `--method sampled`: see shaders/shade_sampled.comp for the estimator. It shares the source
 // pyramid and SH9 passes with the mobile pipeline and skips the prefiltered chain.
-#include "gpu_scene.h"
 #include "harness/common/errors.h"
-#include "ibl_precompute.h"
-#include "mobile_renderer.h"
+#include "renderers/mobile/gpu_scene.h"
+#include "renderers/mobile/ibl_precompute.h"
+#include "renderers/mobile/mobile_renderer.h"
 
 namespace iblcheck {
 
@@ -43,14 +43,14 @@ RenderResult render_sampled(GpuSession& gpu, const Environment& env, const TestS
     vk::GpuTimer timer(ctx, 1);
     ctx.submit([&](VkCommandBuffer cmd) {
         timer.reset(cmd);
-        timer.begin(cmd, "shade_sampled");
         // Bindings 3 and 4 are unused by this shader; the layout keeps the mobile numbering.
-        shade.dispatch(cmd,
-                       {vk::Binding::storage_buffer(0, scene_buf),
-                        vk::Binding::sampled_image(1, ibl.source_cube.sampled_view, ctx.linear_sampler()),
-                        vk::Binding::storage_buffer(2, ibl.sh), vk::Binding::storage_buffer(3, ibl.sh),
-                        vk::Binding::storage_buffer(4, ibl.sh), vk::Binding::storage_buffer(5, out)},
-                       &pc, sizeof pc, (width + 7) / 8, (height + 7) / 8, 1);
+        std::vector<vk::Binding> b = {vk::Binding::storage_buffer(0, scene_buf),
+                                      vk::Binding::sampled_image(1, ibl.source_cube.sampled_view, ctx.linear_sampler()),
+                                      vk::Binding::storage_buffer(2, ibl.sh), vk::Binding::storage_buffer(3, ibl.sh),
+                                      vk::Binding::storage_buffer(4, ibl.sh), vk::Binding::storage_buffer(5, out)};
+        shade.warm_up(cmd, b, &pc, sizeof pc);
+        timer.begin(cmd, "shade_sampled");
+        shade.dispatch(cmd, b, &pc, sizeof pc, (width + 7) / 8, (height + 7) / 8, 1);
         timer.end(cmd);
         ctx.barrier(cmd);
     });
