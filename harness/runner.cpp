@@ -21,9 +21,7 @@
 #include "renderers/renderer.h"
 #include "renderers/scenes/scene.h"
 
-#ifdef IBLCHECK_HAVE_REPORT
 #include "reports/report_writer.h"
-#endif
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -699,14 +697,12 @@ RunSummary run_suite(const RunOptions& o) {
         if (!f) throw InputError(o.json.string() + ": cannot write results JSON");
     }
     if (!o.junit.empty()) write_junit(R, o.junit);
-#ifdef IBLCHECK_HAVE_REPORT
     std::vector<json> history;
     if (!o.history.empty()) {
         append_history(o.history, history_entry(R));
         history = read_history(o.history);
     }
     if (!o.out_dir.empty() && o.report) write_report(R, o.out_dir, o.out_dir, history);
-#endif
     if (!o.quiet)
         fmt::print("{} tests: {} pass, {} fail, {} improved, {} missing-golden, {} error  ({:.1f} s){}\n", tests.size(), s.pass,
                    s.fail, s.improved, s.missing, s.error, R["total_s"].get<double>(),

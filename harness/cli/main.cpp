@@ -17,9 +17,7 @@ int main(int argc, char** argv) {
     iblcheck::cli::register_render_command(app, exit_code);
     iblcheck::register_compare_command(app, exit_code);
     iblcheck::cli::register_run_commands(app, exit_code);
-#ifdef IBLCHECK_HAVE_REPORT_CLI
     iblcheck::cli::register_report_command(app, exit_code);
-#endif
     {
         std::string line = "iblcheck";
         for (int i = 1; i < argc; ++i) line += std::string(" ") + argv[i];

@@ -69,17 +69,19 @@ void register_render_command(CLI::App& app, int& exit_code) {
         vo.device = device;
         Renderer renderer(vo);
         RenderResult r = renderer.render(spec);
+        // With --json - the JSON owns stdout; the human-readable lines go to stderr.
+        FILE* human = json_out == "-" ? stderr : stdout;
         double total = 0;
         for (auto& t : r.timings) {
-            fmt::print("{:<20} {:9.3f} ms  {}{}\n", t.name, t.ms, t.gpu ? "gpu" : "cpu", t.precompute ? "  precompute" : "");
+            fmt::print(human, "{:<20} {:9.3f} ms  {}{}\n", t.name, t.ms, t.gpu ? "gpu" : "cpu", t.precompute ? "  precompute" : "");
             total += t.ms;
         }
-        fmt::print("{:<20} {:9.3f} ms\n", "total", total);
-        fmt::print("texture samples/px  {:.2f}\n", r.texture_fetches_per_pixel);
+        fmt::print(human, "{:<20} {:9.3f} ms\n", "total", total);
+        fmt::print(human, "texture samples/px  {:.2f}\n", r.texture_fetches_per_pixel);
         if (!out.empty()) {
             write_exr(out, r.image);
             write_png(png.string(), display_transform(r.image));
-            fmt::print("wrote {} and {}\n", out, png.string());
+            fmt::print(human, "wrote {} and {}\n", out, png.string());
         }
         if (!json_out.empty()) {
             nlohmann::json j;
