@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "harness/common/errors.h"
+#include "harness/common/markup.h"
 #include "metrics/display_transform.h"
 #include "metrics/flip.h"
 #include "metrics/image_io.h"
@@ -550,22 +551,6 @@ json run_test(const TestCase& tc, Worker& w, const GoldenStore& store, const fs:
     return r;
 }
 
-std::string xml_escape(const std::string& s) {
-    std::string o;
-    for (char c : s) {
-        switch (c) {
-        case '&': o += "&amp;"; break;
-        case '<': o += "&lt;"; break;
-        case '>': o += "&gt;"; break;
-        case '"': o += "&quot;"; break;
-        case '\'': o += "&apos;"; break;
-        default:
-            if (static_cast<unsigned char>(c) < 0x20 && c != '\n' && c != '\t') o += ' ';
-            else o += c;
-        }
-    }
-    return o;
-}
 
 } // namespace
 
@@ -592,19 +577,19 @@ void write_junit(const json& results, const fs::path& file) {
     x += fmt::format("<testsuites name=\"iblcheck\" tests=\"{}\" failures=\"{}\" errors=\"{}\" time=\"{:.3f}\">\n",
                      tests.size(), failures, errors, results.value("total_s", 0.0));
     x += fmt::format("  <testsuite name=\"{}\" tests=\"{}\" failures=\"{}\" errors=\"{}\" skipped=\"0\" time=\"{:.3f}\" timestamp=\"{}\">\n",
-                     xml_escape(suite), tests.size(), failures, errors, results.value("total_s", 0.0),
-                     xml_escape(results.value("started", "")));
+                     escape_markup(suite), tests.size(), failures, errors, results.value("total_s", 0.0),
+                     escape_markup(results.value("started", "")));
     for (auto& t : tests) {
         std::string name = t.value("name", "?"), v = t.value("verdict", "error"), msg = t.value("message", "");
-        x += fmt::format("    <testcase classname=\"{}.{}\" name=\"{}\" time=\"{:.3f}\">", xml_escape(suite),
-                         xml_escape(t.value("method", "")), xml_escape(name), t.value("wall_s", 0.0));
+        x += fmt::format("    <testcase classname=\"{}.{}\" name=\"{}\" time=\"{:.3f}\">", escape_markup(suite),
+                         escape_markup(t.value("method", "")), escape_markup(name), t.value("wall_s", 0.0));
         if (v == "fail" || v == "missing-golden")
-            x += fmt::format("\n      <failure type=\"{}\" message=\"{}\">{}\nrebless: {}</failure>\n    ", v, xml_escape(msg),
-                             xml_escape(msg), xml_escape(t.value("bless_command", "")));
+            x += fmt::format("\n      <failure type=\"{}\" message=\"{}\">{}\nrebless: {}</failure>\n    ", v, escape_markup(msg),
+                             escape_markup(msg), escape_markup(t.value("bless_command", "")));
         else if (v == "error")
-            x += fmt::format("\n      <error type=\"error\" message=\"{}\">{}</error>\n    ", xml_escape(msg), xml_escape(msg));
+            x += fmt::format("\n      <error type=\"error\" message=\"{}\">{}</error>\n    ", escape_markup(msg), escape_markup(msg));
         else if (v == "improved")
-            x += fmt::format("\n      <system-out>improved: {}</system-out>\n    ", xml_escape(msg));
+            x += fmt::format("\n      <system-out>improved: {}</system-out>\n    ", escape_markup(msg));
         x += "</testcase>\n";
     }
     x += "  </testsuite>\n</testsuites>\n";

@@ -1,4 +1,5 @@
 #include "reports/svg_chart.h"
+#include "harness/common/markup.h"
 
 #include <algorithm>
 #include <cmath>
@@ -8,21 +9,7 @@
 
 namespace iblcheck::report {
 
-std::string html_escape(std::string_view s) {
-    std::string o;
-    o.reserve(s.size() + 8);
-    for (char c : s) {
-        switch (c) {
-        case '&': o += "&amp;"; break;
-        case '<': o += "&lt;"; break;
-        case '>': o += "&gt;"; break;
-        case '"': o += "&quot;"; break;
-        case '\'': o += "&#39;"; break;
-        default: o += c;
-        }
-    }
-    return o;
-}
+std::string html_escape(std::string_view s) { return escape_markup(s); }
 
 std::string fmt_num(double v) {
     if (!std::isfinite(v)) return std::isnan(v) ? "NaN" : (v > 0 ? "inf" : "-inf");

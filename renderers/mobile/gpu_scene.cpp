@@ -20,6 +20,13 @@ void put(float* p, Vec3f v, float w) {
 }
 } // namespace
 
+Scene scene_for(const TestSpec& spec, int& width, int& height) {
+    Scene scene = build_scene(spec.scene, spec.options);
+    width = spec.width > 0 ? spec.width : scene.width;
+    height = spec.height > 0 ? spec.height : scene.height;
+    return scene;
+}
+
 vk::Buffer upload_scene(vk::Context& ctx, const Scene& scene) {
     const size_t header = 5 * 16, per_sphere = 3 * 16;
     vk::Buffer buf = ctx.create_buffer(header + per_sphere * std::max<size_t>(1, scene.spheres.size()));

@@ -9,9 +9,8 @@ namespace iblcheck {
 
 RenderResult render_sampled(GpuSession& gpu, const Environment& env, const TestSpec& spec) {
     const OptionMap& o = spec.options;
-    Scene scene = build_scene(spec.scene, o);
-    int width = spec.width > 0 ? spec.width : scene.width;
-    int height = spec.height > 0 ? spec.height : scene.height;
+    int width = 0, height = 0;
+    Scene scene = scene_for(spec, width, height);
 
     PrecomputeSettings ps;
     ps.cube_size = uint32_t(o.get_int("cube_size", 256));
