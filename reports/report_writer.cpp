@@ -372,9 +372,25 @@ void test_card(std::string& o, const json& t, size_t idx, ImageStore& store, con
         for (auto& [k, val] : opts.items()) s += (s.empty() ? "" : ",") + k + "=" + value_text(val);
         meta.push_back("options <span class=\"mono\">" + e(s) + "</span>");
     }
+    const json& tags = sub(t, "tags");
+    if (tags.is_array())
+        for (const json& tag : tags)
+            if (tag.is_string()) {
+                std::string tg = tag.get<std::string>();
+                bool failure = tg.rfind("failure:", 0) == 0;
+                meta.push_back(failure ? "failure mode <b>" + e(tg.substr(8)) + "</b>" : "tag " + e(tg));
+            }
     std::string mj;
     for (auto& m : meta) mj += (mj.empty() ? "" : " &middot; ") + m;
     fmt::format_to(out, "<div class=\"meta\">{}</div>\n", mj);
+    if (const json& st = sub(t, "stability"); st.is_object()) {
+        std::string line = st.value("deterministic", false) ? "bit-identical across repeats and thread counts"
+                                                            : "<b>not deterministic</b>: " + e(str(st, "nondeterminism"));
+        const json& sens = sub(st, "sensitivity");
+        for (auto& [k, val] : sens.items())
+            if (auto f = num(val, "flip.mean")) line += fmt::format(" &middot; {} {} moves FLIP by {}", e(k), e(value_text(sub(val, "value"))), fmt_num(*f));
+        fmt::format_to(out, "<div class=\"meta\">stability: {}</div>\n", line);
+    }
     if (!str(t, "message").empty()) fmt::format_to(out, "<div class=\"message\">{}</div>\n", e(str(t, "message")));
     if (!str(t, "driver_mismatch").empty())
         fmt::format_to(out, "<div class=\"warn\">&#9888; driver mismatch: {} &mdash; differences may come from the "
@@ -641,6 +657,27 @@ void write_report(const json& results, const fs::path& results_dir, const fs::pa
                        e(short_message(str(t, "message"))), e(str(t, "message")));
     }
     o += "</table>\n";
+
+    // ---- failure modes: tests tagged failure:NAME, grouped, with each method's error ----
+    std::map<std::string, std::vector<size_t>> modes;
+    for (size_t i = 0; i < tests.size(); ++i)
+        if (const json& tags = sub(*tests[i], "tags"); tags.is_array())
+            for (const json& tag : tags)
+                if (tag.is_string() && tag.get<std::string>().rfind("failure:", 0) == 0) modes[tag.get<std::string>().substr(8)].push_back(i);
+    if (!modes.empty()) {
+        o += "<h2 id=\"failure-modes\">Failure modes</h2>\n<table class=\"grid\"><tr><th>failure mode</th><th>test</th>"
+             "<th>FLIP vs reference</th><th>verdict</th></tr>\n";
+        for (auto& [mode, idx] : modes)
+            for (size_t k = 0; k < idx.size(); ++k) {
+                const json& t = *tests[idx[k]];
+                auto acc = num(sub(t, "accuracy"), "flip_mean");
+                fmt::format_to(out, "<tr>{}<td><a href=\"#{}\">{}</a></td><td class=\"num\">{}</td><td><span class=\"badge v-{}\">{}</span></td></tr>\n",
+                               k == 0 ? fmt::format("<td rowspan=\"{}\"><b>{}</b></td>", idx.size(), e(mode)) : std::string(),
+                               test_id(idx[k]), e(str(t, "name")), acc ? fmt_num(*acc) : std::string(), e(str(t, "verdict")),
+                               e(str(t, "verdict")));
+            }
+        o += "</table>\n";
+    }
 
     // ---- per-test cards ----
     for (size_t i = 0; i < tests.size(); ++i) test_card(o, *tests[i], i, store, trends[i]);
