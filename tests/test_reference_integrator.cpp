@@ -211,6 +211,10 @@ TEST(ReferenceIntegrator, FurnaceMetalMatchesQuadrature) {
 
 // White dielectric in L = 1: the diffuse lobe alone is exactly 1 (white Lambert); the whole model is
 // 1 + the F0 = 0.04 specular albedo (the model has no (1 − F) on the diffuse term).
+// The earlier 0.26–0.41 % worst pixel (at 8192 spp, tolerance 0.6 %) was noise, not bias: the mean
+// SIGNED error over each sphere's ~320 fully covered pixels is within ±1e-4 for the whole model and
+// for the specular lobe alone (where a 0.3 % bias of the total would be a 10 % error of the F0 = 0.04
+// lobe), for several seeds. Checked here: per-sphere mean signed error (bias) and worst pixel (noise).
 TEST(ReferenceIntegrator, FurnaceDielectricIsLambertPlusSpecular) {
     Scene s = build_scene("furnace_dielectric", {});
     TestSpec diff = spec_of("furnace_dielectric", "constant:1", 4096, 120, 24);
@@ -218,12 +222,17 @@ TEST(ReferenceIntegrator, FurnaceDielectricIsLambertPlusSpecular) {
     ReferenceRender rd = render_reference_full(diff);
     TestSpec all = spec_of("furnace_dielectric", "constant:1", 8192, 120, 24);
     ReferenceRender ra = render_reference_full(all);
+    TestSpec spec_only = spec_of("furnace_dielectric", "constant:1", 8192, 120, 24);
+    spec_only.options.set("lobes", "specular");
+    ReferenceRender rs = render_reference_full(spec_only);
     const int W = ra.result.image.cols, H = ra.result.image.rows;
     std::vector<AlbedoTable> tables;
     for (const auto& sp : s.spheres)
         tables.emplace_back(model::alpha_from_roughness(sp.material.roughness), model::kDielectricF0);
     std::vector<double> mus;
     int checked = 0;
+    double bias_all[5] = {0}, bias_spec[5] = {0}, worst_all[5] = {0}, worst_spec[5] = {0};
+    int n[5] = {0};
     for (int y = 0; y < H; ++y)
         for (int x = 0; x < W; ++x) {
             int sph;
@@ -234,16 +243,32 @@ TEST(ReferenceIntegrator, FurnaceDielectricIsLambertPlusSpecular) {
                                                                : tables[sph](mu);
             spec /= mus.size();
             for (int c = 0; c < 3; ++c) {
-                // 0.4 %: environment samples below the horizon make constant-environment renders noisy.
-                ASSERT_NEAR(rd.result.image.at<cv::Vec3f>(y, x)[c], 1.0, 4e-3) << x << "," << y;
-                // 0.4 %: the F0 = 0.04 lobe is sampled with p_s >= 0.1 only, so this render is noisier
-                // than the metal one at equal spp (worst pixel 0.26-0.41 % at 8192 spp; bias not yet ruled out).
-                ASSERT_NEAR(ra.result.image.at<cv::Vec3f>(y, x)[c] / (1.0 + spec), 1.0, 6e-3)
-                    << x << "," << y << " sphere " << sph;
+                // 0.3 % (was 0.4 %): environment samples below the horizon make constant-environment renders noisy.
+                ASSERT_NEAR(rd.result.image.at<cv::Vec3f>(y, x)[c], 1.0, 3e-3) << x << "," << y;
+                // 0.4 % (was 0.6 %): worst pixel ~0.15-0.25 % at 8192 spp (noise: see the bias check below).
+                double ea = ra.result.image.at<cv::Vec3f>(y, x)[c] / (1.0 + spec) - 1;
+                double es = rs.result.image.at<cv::Vec3f>(y, x)[c] / spec - 1;
+                ASSERT_NEAR(ea, 0.0, 4e-3) << x << "," << y << " sphere " << sph;
+                // The specular lobe alone, relative to itself: 2 % (worst pixel ~0.7-1.1 % at r = 1, where
+                // the lobe is widest and the F0 = 0.04 lobe's share of the samples smallest).
+                ASSERT_NEAR(es, 0.0, 2e-2) << x << "," << y << " sphere " << sph;
+                if (c == 1) {
+                    bias_all[sph] += ea, bias_spec[sph] += es, ++n[sph];
+                    worst_all[sph] = std::max(worst_all[sph], std::fabs(ea));
+                    worst_spec[sph] = std::max(worst_spec[sph], std::fabs(es));
+                }
             }
             ++checked;
         }
     EXPECT_GT(checked, 5 * 200);
+    for (int i = 0; i < 5; ++i) {
+        bias_all[i] /= n[i], bias_spec[i] /= n[i];
+        // No bias: the mean signed error over the sphere is within a few standard errors of 0.
+        EXPECT_LT(std::fabs(bias_all[i]), 3e-4) << "sphere " << i;
+        EXPECT_LT(std::fabs(bias_spec[i]), 1e-3) << "sphere " << i;
+        std::printf("dielectric furnace r=%.2f: whole model mean %+.5f worst %.5f; specular lobe mean %+.5f worst %.5f\n",
+                    0.25 * i, bias_all[i], worst_all[i], bias_spec[i], worst_spec[i]);
+    }
 }
 
 namespace {
@@ -378,4 +403,40 @@ TEST(ReferenceIntegrator, NoiseFloorShrinksWithSpp) {
     EXPECT_LT(hi.relative_rmse, lo.relative_rmse / 3);
     std::printf("sphere/studio 48x48 noise floor: spp 16 -> %.4f, spp 256 -> %.4f\n", lo.relative_rmse,
                 hi.relative_rmse);
+}
+
+// The sub-pixel positions are keyed by pixel_pattern, not by the lighting seed: two seeds cover every
+// pixel identically (so the noise floor is lighting noise only), and the pattern's own error — a
+// 256-point quadrature of the pixel footprint — is small: two patterns give almost the same coverage,
+// and on the mirror sphere (lobes=specular, r = 0: the shading is deterministic per position, so the
+// difference is the pattern error alone) almost the same image.
+TEST(ReferenceIntegrator, PixelPatternErrorIsSmall) {
+    TestSpec spec = spec_of("sphere", "studio", 8192, 64, 64); // positions = spp/4 = 2048
+    spec.options.set("roughness", "0");
+    spec.options.set("metallic", "1");
+    spec.options.set("lobes", "specular");
+    ReferenceRender a = render_reference_full(spec);
+    spec.options.set("seed", "1");
+    ReferenceRender b = render_reference_full(spec);
+    spec.options.set("pixel_pattern", "1");
+    ReferenceRender c = render_reference_full(spec);
+    ASSERT_EQ(cv::norm(a.coverage, b.coverage, cv::NORM_INF), 0.0);
+    // Mirror: no lighting noise at all, so seeds 0 and 1 agree exactly.
+    EXPECT_EQ(cv::norm(a.result.image, b.result.image, cv::NORM_INF), 0.0);
+    double sum_d = 0, edge = 0, cov_a = 0, cov_c = 0;
+    for (int y = 0; y < a.coverage.rows; ++y)
+        for (int x = 0; x < a.coverage.cols; ++x) {
+            double ca = a.coverage.at<float>(y, x), cc = c.coverage.at<float>(y, x);
+            cov_a += ca, cov_c += cc;
+            if ((ca > 0 && ca < 1) || (cc > 0 && cc < 1)) sum_d += std::fabs(ca - cc), ++edge;
+        }
+    ASSERT_GT(edge, 50);
+    EXPECT_LT(sum_d / edge, 2e-3);        // mean |Δcoverage| of silhouette pixels
+    EXPECT_NEAR(cov_c / cov_a, 1.0, 2e-4); // total covered area
+    // The pattern error of the worst case (sharp light edges seen in a mirror) is well below the
+    // 0.5 % relative-RMSE criterion the noise floor is held to.
+    double rel = relative_rmse(a.result.image, c.result.image, a.coverage);
+    EXPECT_LT(rel, 2.5e-3);
+    std::printf("pixel pattern 0 vs 1 (2048 positions): mean |dcoverage| on %d silhouette pixels %.5f, area ratio "
+                "%.6f, mirror-sphere relative RMSE %.5f\n", int(edge), sum_d / edge, cov_c / cov_a, rel);
 }

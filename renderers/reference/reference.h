@@ -4,15 +4,37 @@
 // (environment.h). No Vulkan, no shader code, no prefiltering: nothing shared with the methods it judges
 // except the scene/environment definitions and the model's equations.
 //
-// Estimator (per camera sub-sample; `spp` of them per pixel):
-//   * Pixel: stratified sub-pixel positions (dimension pair 0 of an Owen-scrambled Sobol sequence);
-//     a sub-sample that misses every sphere contributes black, so silhouettes are anti-aliased.
-//   * Lighting: multiple importance sampling, power heuristic (β = 2), one sample from each of two
+// Estimator (`spp` = lighting samples per pixel, nominal):
+//   * Pixel footprint: P sub-pixel positions (option positions, default spp/4, at most spp), an Owen-scrambled
+//     Sobol pattern per pixel keyed by the option pixel_pattern and the pixel, NOT by the lighting seed:
+//     renders with different seeds integrate the footprint with the same points, so the between-seeds
+//     noise floor measures lighting noise only. (Measured: at 256 spp the FLIP heatmap between seeds
+//     shows the silhouette ring with either keying — the ring is lighting noise of partially covered
+//     pixels, few hits carrying all the lighting noise of a dim pixel — see the adaptive counts below.)
+//     The pattern's own error (a P-point quadrature of the footprint, which the noise floor cannot see)
+//     is measured by comparing two patterns on the worst case, a mirror sphere under studio (sharp light
+//     edges in the reflection; lobes=specular makes the shading deterministic per position): relative
+//     RMSE 1.2 % / 0.49 % / 0.04 % / 0.009 % and mean FLIP 0.0026 / 0.0011 / 0.0005 / 0.0002 at
+//     P = 256 / 1024 / 4096 / 16384 — hence P = spp/4, not a fixed small P (tests/
+//     test_reference_integrator.cpp, PixelPatternErrorIsSmall; CONVERGENCE.md).
+//     A position that misses every sphere contributes black, so silhouettes are anti-aliased.
+//   * Lighting samples per hit position: M (Sobol indices k·M .. k·M + M − 1 of the pixel's lighting
+//     sequence for position k, so the P·M points of an interior pixel form one stratified sequence).
+//     M̄ = spp/P (4 by default). adaptive = 1 (default): a pilot pass with its own random numbers
+//     (the first 32 positions × 2 samples)
+//     estimates per pixel r = σ_L/√(μ² + 0.01) (σ_L: per-sample std of the luminance over the hits,
+//     μ: the pixel's value — the relative-RMSE metric's normalisation); M ∝ r (3x3 max), mean spp/P,
+//     clamped to [M̄/4, adaptive_cap·M̄] (cap 16). The pilot's samples are discarded, so the counts are
+//     independent of the main samples and every pixel's estimate stays unbiased (Owen-scrambled Sobol
+//     is unbiased for any count). adaptive = 0: M = spp/P everywhere.
+//   * Lighting (each sample): multiple importance sampling, power heuristic (β = 2), one sample from each of two
 //     strategies over the WHOLE BRDF (diffuse + specular evaluated together for every sample):
 //       (a) BRDF sampling: with probability p_s sample the GGX visible-normal distribution (Heitz 2018,
 //           "Sampling the GGX Distribution of Visible Normals"; pdf(l) = D(h)·G1(v)/(4 n·v) with the
 //           Smith G1 = 2n·v/(n·v + √(α² + (1−α²)(n·v)²))), else the cosine-weighted hemisphere
-//           (pdf = n·l/π); the strategy's pdf is the mixture p_s·pdf_vndf + (1−p_s)·pdf_cos.
+//           (pdf = n·l/π); the strategy's pdf is the mixture p_s·pdf_vndf + (1−p_s)·pdf_cos. The lobe is
+//           chosen by splitting the second Sobol coordinate at p_s (rescaled), not by a separate number,
+//           so each lobe keeps a stratified share of the points.
 //           p_s = spec/(spec+diff) with spec = mean_c Schlick(F0_c, n·v), diff = mean_c (1−m)·c_c.
 //       (b) environment sampling: a piecewise-constant 2D distribution over the equirect pixels
 //           ∝ luminance·(solid angle of the pixel) (marginal rows, conditional columns), where the
@@ -22,7 +44,10 @@
 //           placed uniformly in SOLID ANGLE inside the pixel (cos θ uniform, φ uniform), so
 //           pdf(ω) = P_pixel / Ω_pixel — constant per pixel, no 1/sin θ spike at the poles. (Uniform-in-uv
 //           placement, pdf = p(u,v)·W·H/(2π² sin θ), was measured to double the noise of upward-facing
-//           normals in a constant environment.)
+//           normals in a constant environment.) The CDFs are inverted through guide tables (cutpoint
+//           method: O(1) expected, still monotone, so the Sobol stratification carries over to the
+//           environment — an alias table would lose it); the per-pixel pdf is stored (float) and shared by
+//           sample() and pdf(), so the estimator sees exactly the density it samples.
 //   * Mirror limit: for α < 1e-4 (roughness < 0.01, in practice r = 0) the specular lobe is the delta
 //     F(n·v)·L(reflect(v)) — one lookup, exact — and MIS (a)+(b) covers the diffuse lobe only.
 //     No α clamp anywhere else.
@@ -30,13 +55,22 @@
 //   * No occlusion or inter-reflection between spheres: the integral is image-based lighting, the one
 //     every method approximates.
 //   * Random numbers: per pixel, hash(seed, x, y) seeds Owen-scrambled, index-shuffled Sobol (0,2)
-//     pairs (Burley 2020, "Practical Hash-based Owen Scrambling"): no shared RNG state, so the image is
-//     bit-identical for any thread count and every run.
+//     pairs (Burley 2020, "Practical Hash-based Owen Scrambling"); hash(pixel_pattern, x, y) the
+//     positions: no shared RNG state, and the adaptive counts are a deterministic function of the pilot,
+//     so the image is bit-identical for any thread count and every run.
+//   * Speed (measured with perf; 2-core machine, roughness_sweep/studio 64 spp, 1 thread: 2.8 s -> 2.0 s
+//     before the adaptive counts): per-pixel sphere culling (conservative pixel-cone test, then the
+//     intersection arithmetic of scene.cpp over the candidates), per-sphere material constants, one
+//     direction -> uv conversion shared by the pdf and the bilinear lookup (and none for environment
+//     samples, whose uv is known), guide-table CDF inversion, stored per-pixel pdf. Convergence table
+//     (spp vs noise floor vs time): renderers/reference/CONVERGENCE.md.
 //
 // Options (TestSpec.options; unknown keys are ignored — they may belong to other methods):
-//   roughness, metallic, base_color (scene_option_keys), spp (default 256), seed (default 0),
-//   threads (0 = hardware concurrency), env_rotation (degrees about +Y), lobes = all|diffuse|specular
-//   (debug/test: evaluate only that lobe of the model).
+//   roughness, metallic, base_color (scene_option_keys), spp (default 256), seed (default 0; the
+//   lighting random numbers), pixel_pattern (default 0; the sub-pixel positions), positions (default
+//   spp/4), adaptive (default 1), adaptive_cap (default 16), mis = power|balance, threads (0 = hardware
+//   concurrency), env_rotation (degrees about +Y), lobes = all|diffuse|specular (debug/test: evaluate
+//   only that lobe of the model).
 #pragma once
 #include <cstdint>
 #include <optional>
@@ -63,13 +97,15 @@ struct ReferenceRender {
 };
 ReferenceRender render_reference_full(const TestSpec& spec, const Environment* env = nullptr);
 
-// Noise floor of the reference at `spp`: two renders with independent seeds (seed and seed + 1 where
-// seed is the spec's, default 0), compared over covered pixels (coverage > 0):
+// Noise floor of the reference at `spp`: two renders with independent lighting seeds (seed and seed + 1
+// where seed is the spec's, default 0; the same pixel_pattern), compared over covered pixels (coverage > 0):
 //   relative_rmse = sqrt(mean over covered pixels and channels of (a − b)² / (m² + 0.01)), m = (a + b)/2
 //   (per-pixel relative error, Rousselle et al. 2011: the sun's few edge pixels do not dominate it).
 // This is the between-seeds figure; each render's own RMS error against the true image is ≈ it / √2.
 // mean_flip: hook for the FLIP metric (metrics/); not filled in here (the metrics library is not a
-// dependency of the reference), callers holding both images may compute it.
+// dependency of the reference), callers holding both images may compute it (the tool does).
+// Issue 5's criterion: mean FLIP < 0.002 and relative RMSE < 0.005 between the seeds. What each
+// golden reaches, and at what cost, is in CONVERGENCE.md and in the golden's JSON (noise_floor.criterion).
 struct NoiseFloor {
     int spp = 0;
     int seed_a = 0, seed_b = 1;
@@ -96,6 +132,11 @@ class EnvDistribution {
     // Samples a world direction from (u1, u2) in [0,1)²; returns its solid-angle pdf (0: no sample).
     double sample(double u1, double u2, double dir[3]) const;
     double pdf(const double dir[3]) const;
+    // The same in equirect uv (u, v in [0,1), env space, i.e. after undoing the rotation): sample_uv
+    // also returns the sample's uv, to_uv maps a world direction to it, pdf_uv is pdf() at a uv.
+    double sample_uv(double u1, double u2, double dir[3], double& u, double& v) const;
+    void to_uv(const double dir[3], double& u, double& v) const;
+    double pdf_uv(double u, double v) const;
 
   private:
     int w_ = 0, h_ = 0;
@@ -103,8 +144,11 @@ class EnvDistribution {
     double rot_c_ = 1, rot_s_ = 0; // env -> world rotation by +rotation_deg about +Y
     std::vector<double> marginal_cdf_;    // h_ + 1
     std::vector<double> conditional_cdf_; // h_ * (w_ + 1)
-    std::vector<double> prob_;            // w_ * h_, pixel probabilities
+    std::vector<int> marginal_guide_;     // h_ (cutpoint guide table)
+    std::vector<int> conditional_guide_;  // h_ * w_
+    std::vector<float> pdf_;              // w_ * h_, solid-angle pdf of each pixel
     std::vector<double> row_dcos_;        // h_: cos θ_top − cos θ_bottom of each row
+    std::vector<double> row_cos_top_;     // h_
 };
 
 // Owen-scrambled shuffled Sobol pair (Burley 2020) in [0,1)², deterministic in (index, seed).

@@ -70,7 +70,16 @@ int main(int argc, char** argv) {
                                    {"mean_value", nf.mean_value},
                                    {"covered_pixels", nf.covered_pixels},
                                    {"seeds", {nf.seed_a, nf.seed_b}},
-                                   {"mean_flip", compute_flip_hdr(nf.image_a, nf.image_b, FlipOptions{}).mean}};
+                                   {"mean_flip", compute_flip_hdr(nf.image_a, nf.image_b, FlipOptions{}).mean},
+                                   {"what_differs", "the lighting random numbers only: both renders integrate each pixel's "
+                                                    "footprint with the same sub-pixel pattern (pixel_pattern), see reference.h"}};
+            // Issue 5's convergence criterion, stated with its verdict.
+            const double flip = meta["noise_floor"]["mean_flip"].get<double>();
+            meta["noise_floor"]["criterion"] = {{"mean_flip_below", 0.002},
+                                                {"relative_rmse_below", 0.005},
+                                                {"mean_flip_met", flip < 0.002},
+                                                {"relative_rmse_met", nf.relative_rmse < 0.005},
+                                                {"met", flip < 0.002 && nf.relative_rmse < 0.005}};
             meta["seeds"] = {nf.seed_a, nf.seed_b};
             meta["provenance"] = nf.provenance_a;
         } else {
