@@ -19,10 +19,13 @@ cmake --build "$BUILD_DIR" -j"$JOBS" --target iblcheck_reference_tool >/dev/null
 TOOL=$(find "$BUILD_DIR" -name iblcheck_reference_tool -type f -perm -u+x | head -1)
 mkdir -p "$OUT"
 start=$(date +%s)
-render() { # scene env spp: the file name is harness/golden_store.h's reference_key (':' '/' -> '-')
-  local scene=$1 env=$2 spp=${SPP:-$3} name
-  name="${scene}__${env//[:\/]/-}"
-  "$TOOL" --scene "$scene" --env "$env" --spp "$spp" --seed 0 --noise-floor \
+render() { # scene env spp [key=value...]: the file name is harness/golden_store.h's reference_key
+  # (':' '/' -> '-'; material options appended as __k=v,k=v in sorted order)
+  local scene=$1 env=$2 spp=${SPP:-$3} name sets=() opts=""
+  shift 3
+  for kv in $(printf '%s\n' "$@" | sort); do sets+=(--set "$kv"); opts+="${opts:+,}$kv"; done
+  name="${scene}__${env//[:\/]/-}${opts:+__$opts}"
+  "$TOOL" --scene "$scene" --env "$env" --spp "$spp" --seed 0 --noise-floor "${sets[@]}" \
     --out "$OUT/$name.exr" --meta "$OUT/$name.json" \
     --command "scripts/regenerate_reference_goldens.sh (spp=$spp)"
 }
@@ -38,4 +41,5 @@ render furnace constant:1 4096               # 0.10 %, FLIP 0.0007
 render furnace_dielectric constant:1 4096    # 0.11 %, FLIP 0.0008
 render sphere studio 8192                    # 0.27 %, FLIP 0.0021
 render grazing studio 8192                   # 0.20 %, FLIP 0.0010
+render sphere studio 8192 metallic=1 roughness=0.02   # stability suite: a near-mirror on sharp lights
 echo "[goldens] done in $(( $(date +%s) - start )) s -> $OUT"
