@@ -180,6 +180,21 @@ void uv_to_direction(float u, float v, float d[3]) {
     d[2] = float(-st * std::cos(phi));
 }
 
+void bilinear_equirect(const float* data, int W, int H, size_t stride, double u, double v, double rgb[3]) {
+    double x = u * W - 0.5, y = v * H - 0.5;
+    double fx0 = std::floor(x), fy0 = std::floor(y);
+    double fx = x - fx0, fy = y - fy0;
+    int x0 = int(fx0) % W;
+    if (x0 < 0) x0 += W;
+    int x1 = x0 + 1 == W ? 0 : x0 + 1;
+    int y0 = std::clamp(int(fy0), 0, H - 1), y1 = std::clamp(int(fy0) + 1, 0, H - 1);
+    const float* r0 = data + size_t(y0) * stride;
+    const float* r1 = data + size_t(y1) * stride;
+    const float *a = r0 + 3 * x0, *b = r0 + 3 * x1, *c = r1 + 3 * x0, *e = r1 + 3 * x1;
+    for (int k = 0; k < 3; ++k)
+        rgb[k] = (1 - fy) * ((1 - fx) * a[k] + fx * b[k]) + fy * ((1 - fx) * c[k] + fx * e[k]);
+}
+
 void sample_bilinear(const Environment& env, const float d_in[3], float rgb[3]) {
     float d[3] = {d_in[0], d_in[1], d_in[2]};
     if (env.rotation_deg != 0) {
@@ -191,20 +206,9 @@ void sample_bilinear(const Environment& env, const float d_in[3], float rgb[3]) 
     float u, v;
     direction_to_uv(d, u, v);
     const cv::Mat& m = env.equirect;
-    const int W = m.cols, H = m.rows;
-    double x = double(u) * W - 0.5, y = double(v) * H - 0.5;
-    double fx0 = std::floor(x), fy0 = std::floor(y);
-    double fx = x - fx0, fy = y - fy0;
-    int x0 = int(fx0) % W;
-    if (x0 < 0) x0 += W;
-    int x1 = x0 + 1 == W ? 0 : x0 + 1;
-    int y0 = std::clamp(int(fy0), 0, H - 1), y1 = std::clamp(int(fy0) + 1, 0, H - 1);
-    const auto& a = m.at<cv::Vec3f>(y0, x0);
-    const auto& b = m.at<cv::Vec3f>(y0, x1);
-    const auto& c = m.at<cv::Vec3f>(y1, x0);
-    const auto& e = m.at<cv::Vec3f>(y1, x1);
-    for (int k = 0; k < 3; ++k)
-        rgb[k] = float((1 - fy) * ((1 - fx) * a[k] + fx * b[k]) + fy * ((1 - fx) * c[k] + fx * e[k]));
+    double out[3];
+    bilinear_equirect(m.ptr<float>(0), m.cols, m.rows, m.step1(), u, v, out);
+    for (int k = 0; k < 3; ++k) rgb[k] = float(out[k]);
 }
 
 } // namespace iblcheck

@@ -43,6 +43,8 @@ Environment load_environment(const std::string& spec);
 // Direction ↔ equirect helpers (the convention above).
 void direction_to_uv(const float d[3], float& u, float& v);
 void uv_to_direction(float u, float v, float d[3]);
+// Bilinear lookup at (u, v) of RGB float rows (`stride` floats apart), wrapping in u, clamped in v.
+void bilinear_equirect(const float* data, int width, int height, size_t stride, double u, double v, double rgb[3]);
 // Bilinear lookup of the equirect in direction d (unit), honouring env.rotation_deg.
 void sample_bilinear(const Environment& env, const float d[3], float rgb[3]);
 

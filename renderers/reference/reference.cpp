@@ -227,20 +227,7 @@ struct EnvImage {
     size_t stride = 0; // floats per row
     explicit EnvImage(const cv::Mat& m)
         : data(m.ptr<float>(0)), W(m.cols), H(m.rows), stride(m.step1()) {}
-    void lookup(double u, double v, double rgb[3]) const {
-        double x = u * W - 0.5, y = v * H - 0.5;
-        double fx0 = std::floor(x), fy0 = std::floor(y);
-        double fx = x - fx0, fy = y - fy0;
-        int x0 = int(fx0) % W;
-        if (x0 < 0) x0 += W;
-        int x1 = x0 + 1 == W ? 0 : x0 + 1;
-        int y0 = std::clamp(int(fy0), 0, H - 1), y1 = std::clamp(int(fy0) + 1, 0, H - 1);
-        const float* r0 = data + size_t(y0) * stride;
-        const float* r1 = data + size_t(y1) * stride;
-        const float *a = r0 + 3 * x0, *b = r0 + 3 * x1, *c = r1 + 3 * x0, *e = r1 + 3 * x1;
-        for (int k = 0; k < 3; ++k)
-            rgb[k] = (1 - fy) * ((1 - fx) * a[k] + fx * b[k]) + fy * ((1 - fx) * c[k] + fx * e[k]);
-    }
+    void lookup(double u, double v, double rgb[3]) const { bilinear_equirect(data, W, H, stride, u, v, rgb); }
 };
 
 struct Shader {
@@ -458,20 +445,12 @@ bool intersect_candidates(const Scene& scene, const std::vector<int>& cand, Vec3
     double best_t = INFINITY;
     sphere = -1;
     for (int i : cand) {
-        const Sphere& s = scene.spheres[i];
-        double ox = double(origin.x) - s.center.x, oy = double(origin.y) - s.center.y,
-               oz = double(origin.z) - s.center.z;
-        double b = ox * dir.x + oy * dir.y + oz * dir.z;
-        double c = ox * ox + oy * oy + oz * oz - double(s.radius) * s.radius;
-        double disc = b * b - c;
-        if (disc < 0) continue;
-        double sq = std::sqrt(disc);
-        double t = -b - sq;
-        if (t <= 1e-6) t = -b + sq;
-        if (t <= 1e-6 || t >= best_t) continue;
+        double oc[3];
+        double t = intersect_sphere(scene.spheres[i], origin, dir, oc);
+        if (t >= best_t) continue;
         best_t = t;
         sphere = i;
-        double px = ox + t * dir.x, py = oy + t * dir.y, pz = oz + t * dir.z;
+        double px = oc[0] + t * dir.x, py = oc[1] + t * dir.y, pz = oc[2] + t * dir.z;
         normal = V3{px, py, pz};
     }
     if (sphere < 0) return false;

@@ -223,22 +223,27 @@ Scene build_scene(const std::string& name, const OptionMap& options) {
     throw UsageError("unknown scene '" + name + "'; valid scenes: " + valid);
 }
 
+double intersect_sphere(const Sphere& s, Vec3f origin, Vec3f dir, double oc[3]) {
+    // |o + t d - c|^2 = r^2 with |d| = 1: t^2 + 2 b t + c = 0
+    oc[0] = double(origin.x) - s.center.x, oc[1] = double(origin.y) - s.center.y, oc[2] = double(origin.z) - s.center.z;
+    double b = oc[0] * dir.x + oc[1] * dir.y + oc[2] * dir.z;
+    double c = oc[0] * oc[0] + oc[1] * oc[1] + oc[2] * oc[2] - double(s.radius) * s.radius;
+    double disc = b * b - c;
+    if (disc < 0) return INFINITY;
+    double sq = std::sqrt(disc);
+    double t = -b - sq;
+    if (t <= 1e-6) t = -b + sq;
+    return t <= 1e-6 ? INFINITY : t;
+}
+
 Hit intersect(const Scene& scene, Vec3f origin, Vec3f dir) {
     Hit best;
     double best_t = INFINITY;
     for (size_t i = 0; i < scene.spheres.size(); ++i) {
-        const Sphere& s = scene.spheres[i];
-        // |o + t d - c|^2 = r^2 with |d| = 1: t^2 + 2 b t + c = 0
-        double ox = double(origin.x) - s.center.x, oy = double(origin.y) - s.center.y,
-               oz = double(origin.z) - s.center.z;
-        double b = ox * dir.x + oy * dir.y + oz * dir.z;
-        double c = ox * ox + oy * oy + oz * oz - double(s.radius) * s.radius;
-        double disc = b * b - c;
-        if (disc < 0) continue;
-        double sq = std::sqrt(disc);
-        double t = -b - sq;
-        if (t <= 1e-6) t = -b + sq;
-        if (t <= 1e-6 || t >= best_t) continue;
+        double oc[3];
+        double t = intersect_sphere(scene.spheres[i], origin, dir, oc);
+        if (t >= best_t) continue;
+        const double ox = oc[0], oy = oc[1], oz = oc[2];
         best_t = t;
         best.hit = true;
         best.sphere = int(i);

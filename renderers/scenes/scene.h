@@ -75,6 +75,10 @@ struct Hit {
     Vec3f position, normal;
 };
 Hit intersect(const Scene& scene, Vec3f origin, Vec3f dir);
+// Distance along (o, d), d unit, to the sphere's nearest surface in front of o (1e-6 onwards), or
+// +infinity; also o − centre, from which callers take the hit point. Shared by intersect() and the
+// reference integrator's culled loop, so both see the same arithmetic.
+double intersect_sphere(const Sphere& s, Vec3f origin, Vec3f dir, double oc[3]);
 
 // Camera ray through (px, py) in pixel units (x + sx, y + sy); see the convention above.
 void camera_ray(const Scene& scene, int width, int height, double px, double py, Vec3f& origin, Vec3f& dir);
