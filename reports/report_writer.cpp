@@ -2,6 +2,7 @@
 #include "reports/report_writer.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <fstream>
 #include <iterator>
@@ -683,10 +684,41 @@ void write_report(const json& results, const fs::path& results_dir, const fs::pa
     for (size_t i = 0; i < tests.size(); ++i) test_card(o, *tests[i], i, store, trends[i]);
 
     // ---- speed against accuracy ----
+    // Methods are compared on the same scene and environment: one row of charts per (scene, env),
+    // then every test together (folded away: costs and errors of different scenes do not compare).
+    auto group_of = [](const json& t) { return str(t, "scene") + " \u00b7 " + str(t, "env"); };
+    auto group_id = [](std::string g) {
+        for (char& ch : g)
+            if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '-';
+        return g;
+    };
+    std::map<std::string, std::vector<size_t>> groups;
+    for (size_t i = 0; i < tests.size(); ++i)
+        if (num(sub(*tests[i], "accuracy"), "flip_mean")) groups[group_of(*tests[i])].push_back(i);
     o += "<h2 id=\"speed\">Speed against accuracy</h2>\n<p class=\"meta\">Cost (x) against mean FLIP error vs the "
-         "reference golden (y) for every test that has both. The dashed staircase is the Pareto front: no other test "
-         "is both cheaper and more accurate than the ringed points. Frame time is per-frame shading on this driver; "
-         "texture fetches per pixel do not depend on the driver.</p>\n<div class=\"charts\">";
+         "reference golden (y), one row per scene and environment. The dashed staircase is the Pareto front: no other "
+         "test is both cheaper and more accurate than the ringed points. Frame time is per-frame shading on this driver; "
+         "texture fetches per pixel do not depend on the driver.</p>\n";
+    std::vector<std::pair<std::string, std::vector<size_t>>> ordered(groups.begin(), groups.end());
+    std::stable_sort(ordered.begin(), ordered.end(), [](auto& a, auto& b) { return a.second.size() > b.second.size(); });
+    for (auto& [g, idx] : ordered) {
+        if (idx.size() < 2) continue;
+        std::vector<const json*> gt;
+        std::vector<size_t> go;
+        for (size_t i : idx) {
+            gt.push_back(tests[i]);
+            go.push_back(order[i]);
+        }
+        const std::string id = group_id(g);
+        fmt::format_to(out, "<h3>{}</h3><div class=\"charts\">", e(g));
+        o += speed_chart(gt, "frame_ms", "speed-" + id, "Per-frame shading time vs error \u00b7 " + g, "frame time, ms", true, go) +
+             speed_chart(gt, "texture_fetches_per_pixel", "fetches-" + id, "Texture fetches per pixel vs error \u00b7 " + g,
+                         "texture fetches per pixel", false, go) +
+             speed_chart(gt, "precompute_ms", "precompute-" + id, "Precompute time vs error \u00b7 " + g,
+                         "precompute time, ms", true, go);
+        o += "</div>\n";
+    }
+    o += "<details><summary>All tests in one chart</summary><div class=\"charts\">";
     {
         std::string charts = speed_chart(tests, "frame_ms", "speed-accuracy", "Per-frame shading time vs error",
                                          "frame time, ms", true, order) +
@@ -698,41 +730,52 @@ void write_report(const json& results, const fs::path& results_dir, const fs::pa
         o += charts.empty() ? "<p class=\"meta\">No test has both a cost and an accuracy (FLIP vs a reference golden).</p>"
                             : charts;
     }
-    o += "</div>\n";
+    o += "</div></details>\n";
 
-    // ---- error against roughness ----
+    // ---- error against roughness: one chart per scene and environment, then all together ----
+    auto roughness_chart = [&](const std::string& id, const std::string& title, const std::string& env_filter) -> std::string {
+            Chart c;
+            c.id = id;
+            c.title = title;
+            c.note = "solid: metal, dashed: dielectric; one colour per test (method, variant, environment)";
+            c.x = {"roughness", false, 0.0, 1.0};
+            c.y = {"mean FLIP vs reference", false, {}, {}};
+            size_t colour = 0;
+            for (size_t i = 0; i < tests.size(); ++i) {
+                const json& t = *tests[i];
+                if (!env_filter.empty() && group_of(t) != env_filter) continue;
+                const json& ps = sub(t, "per_sphere");
+                if (!ps.is_array() || ps.empty()) continue;
+                const std::string col = kPalette[colour++ % std::size(kPalette)];
+                std::string base = test_label(t);
+                if (!str(t, "env").empty()) base += " \u00b7 " + str(t, "env");
+                ChartSeries metal{base + " \u00b7 metal", col, false, true, {}};
+                ChartSeries diel{base + " \u00b7 dielectric", col, true, true, {}};
+                for (const json& s : ps) {
+                    const double m = num(s, "metallic").value_or(0);
+                    ChartPoint p;
+                    p.x = num(s, "roughness").value_or(0);
+                    p.y = num(s, "flip_mean").value_or(0);
+                    p.tooltip = fmt::format("{}\n{}: roughness {}, metallic {}, FLIP {}", str(t, "name"), str(s, "label"),
+                                            fmt_num(p.x), fmt_num(m), fmt_num(p.y));
+                    p.href = "#" + test_id(i);
+                    (m >= 0.5 ? metal : diel).points.push_back(std::move(p));
+                }
+                if (!metal.points.empty()) c.series.push_back(std::move(metal));
+                if (!diel.points.empty()) c.series.push_back(std::move(diel));
+            }
+            return c.series.empty() ? std::string() : render_chart(c);
+    };
     o += "<h2 id=\"roughness\">Error against roughness</h2>\n<div class=\"charts\">";
     {
-        Chart c;
-        c.id = "error-roughness";
-        c.title = "Per-sphere FLIP vs the reference, by roughness";
-        c.note = "solid: metal, dashed: dielectric; one colour per test (method, variant, environment)";
-        c.x = {"roughness", false, 0.0, 1.0};
-        c.y = {"mean FLIP vs reference", false, {}, {}};
-        size_t colour = 0;
-        for (size_t i = 0; i < tests.size(); ++i) {
-            const json& t = *tests[i];
-            const json& ps = sub(t, "per_sphere");
-            if (!ps.is_array() || ps.empty()) continue;
-            const std::string col = kPalette[colour++ % std::size(kPalette)];
-            std::string base = test_label(t);
-            if (!str(t, "env").empty()) base += " \u00b7 " + str(t, "env");
-            ChartSeries metal{base + " \u00b7 metal", col, false, true, {}};
-            ChartSeries diel{base + " \u00b7 dielectric", col, true, true, {}};
-            for (const json& s : ps) {
-                const double m = num(s, "metallic").value_or(0);
-                ChartPoint p;
-                p.x = num(s, "roughness").value_or(0);
-                p.y = num(s, "flip_mean").value_or(0);
-                p.tooltip = fmt::format("{}\n{}: roughness {}, metallic {}, FLIP {}", str(t, "name"), str(s, "label"),
-                                        fmt_num(p.x), fmt_num(m), fmt_num(p.y));
-                p.href = "#" + test_id(i);
-                (m >= 0.5 ? metal : diel).points.push_back(std::move(p));
-            }
-            if (!metal.points.empty()) c.series.push_back(std::move(metal));
-            if (!diel.points.empty()) c.series.push_back(std::move(diel));
-        }
-        o += c.series.empty() ? "<p class=\"meta\">No test has per-sphere errors.</p>" : render_chart(c);
+        std::set<std::string> with_spheres;
+        for (const json* t : tests)
+            if (sub(*t, "per_sphere").is_array() && !sub(*t, "per_sphere").empty()) with_spheres.insert(group_of(*t));
+        for (const auto& g : with_spheres)
+            o += roughness_chart("error-roughness-" + group_id(g), "Per-sphere FLIP vs the reference \u00b7 " + g, g);
+        std::string all = roughness_chart("error-roughness", "Per-sphere FLIP vs the reference, by roughness (all tests)", "");
+        o += all.empty() ? "<p class=\"meta\">No test has per-sphere errors.</p>"
+                         : "</div><details><summary>All tests in one chart</summary><div class=\"charts\">" + all + "</div></details><div>";
     }
     o += "</div>\n";
 
