@@ -189,7 +189,9 @@ std::shared_ptr<IblResources> precompute_cached(GpuSession& gpu, const Environme
                       std::to_string(s.rgbm_range) + ";" + std::to_string(s.prefiltered) + ";" + std::to_string(s.lut) +
                       ";" + std::to_string(s.lut_size) + ";" + std::to_string(s.lut_samples) + ";" +
                       std::to_string(s.irradiance_cube) + ";" + std::to_string(s.irradiance_size) + ";" +
-                      std::to_string(s.env_rotation_deg) + ";" + vk::shader_tree_hash();
+                      std::to_string(s.env_rotation_deg);
+    // No shader hash in the key: the session's pipelines are cached by name and defines too, so a
+    // session renders with the sources it first compiled either way.
     struct Entry {
         std::shared_ptr<IblResources> ibl;
         std::vector<PassTiming> timings;
