@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cstdio>
 #include <cmath>
 #include <thread>
 
@@ -70,7 +71,7 @@ void sobol_owen_2d(uint32_t index, uint32_t seed, double& x, double& y) {
     y = double(sy >> 8) * (1.0 / 16777216.0);
 }
 
-EnvDistribution::EnvDistribution(const Environment& env) {
+EnvDistribution::EnvDistribution(const Environment& env, double compensation) {
     const cv::Mat& m = env.equirect;
     w_ = m.cols, h_ = m.rows;
     double a = double(env.rotation_deg) * kPi / 180;
@@ -87,6 +88,19 @@ EnvDistribution::EnvDistribution(const Environment& env) {
     marginal_cdf_.assign(h_ + 1, 0.0);
     conditional_cdf_.assign(size_t(h_) * (w_ + 1), 0.0);
     std::vector<double> prob(size_t(w_) * h_, 0.0);
+    // MIS compensation (Karlík, Šik, Vévoda, Skřivan, Křivánek 2019, "MIS Compensation: Optimizing
+    // Sampling Techniques in Multiple Importance Sampling", ACM TOG 38(6)): when this strategy is
+    // combined by MIS with BRDF sampling, sampling ∝ max(0, Y − Ȳ) instead of ∝ Y is near optimal for
+    // the combination — the uniform part of the environment is left to BRDF sampling, which follows the
+    // BRDF exactly, and this strategy spends its samples on what stands out (lights, the sun).
+    double mean_y = 0;
+    if (compensation > 0) {
+        for (int j = 0; j < h_; ++j) {
+            double dcos = std::cos(j * kPi / h_) - std::cos((j + 1) * kPi / h_);
+            for (int i = 0; i < w_; ++i) mean_y += lum[size_t(j) * w_ + i] * dcos;
+        }
+        mean_y *= compensation * (2 * kPi / w_) / (4 * kPi);
+    }
     for (int j = 0; j < h_; ++j) {
         // Exact solid angle of the row's pixels / (2π/W): cos θ_top − cos θ_bottom.
         row_cos_top_[j] = std::cos(j * kPi / h_);
@@ -103,7 +117,7 @@ EnvDistribution::EnvDistribution(const Environment& env) {
                     mx = std::max(mx, lum[size_t(jj) * w_ + ii]);
                 }
             }
-            double wgt = mx * st;
+            double wgt = std::max(0.0, mx - mean_y) * st;
             prob[size_t(j) * w_ + i] = wgt;
             cdf[i + 1] = cdf[i] + wgt;
         }
@@ -134,6 +148,58 @@ EnvDistribution::EnvDistribution(const Environment& env) {
     for (int j = 0; j < h_; ++j)
         if (conditional_cdf_[size_t(j) * (w_ + 1) + w_] > 0)
             build_guide(&conditional_cdf_[size_t(j) * (w_ + 1)], w_, conditional_guide_, size_t(j) * w_);
+
+    // Coarse cells for the windowed distribution: at most 128x64 (2.8 degrees), each a block of pixels.
+    // (64x32 was measured first: studio sweep at 1024 spp, mean FLIP between seeds 0.0073 -> 0.0067 and
+    // relative RMSE 0.90 % -> 0.83 % with the finer cells, for 17 % more time spent building windows.)
+    cw_ = std::min(128, w_), ch_ = std::min(64, h_);
+    cell_i0_.resize(cw_ + 1), cell_j0_.resize(ch_ + 1);
+    for (int c = 0; c <= cw_; ++c) cell_i0_[c] = int(int64_t(c) * w_ / cw_);
+    for (int c = 0; c <= ch_; ++c) cell_j0_[c] = int(int64_t(c) * h_ / ch_);
+    const int nc = cw_ * ch_;
+    cell_mass_.assign(nc, 0.0);
+    cell_dir_.assign(size_t(nc) * 3, 0.0);
+    cell_rad_.assign(nc, 0.0);
+    cell_omega_.assign(nc, 0.0);
+    cell_cos_rad_.assign(nc, 1.0);
+    cell_sin_rad_.assign(nc, 0.0);
+    cell_row_off_.assign(nc, 0);
+    cell_row_cdf_.clear();
+    auto env_dir = [&](double u, double v, double d[3]) { // equirect uv -> world direction
+        double phi = (u - 0.5) * 2 * kPi, th = v * kPi;
+        double e[3] = {std::sin(th) * std::sin(phi), std::cos(th), -std::sin(th) * std::cos(phi)};
+        d[0] = rot_c_ * e[0] + rot_s_ * e[2];
+        d[1] = e[1];
+        d[2] = -rot_s_ * e[0] + rot_c_ * e[2];
+    };
+    for (int cy = 0; cy < ch_; ++cy)
+        for (int cx = 0; cx < cw_; ++cx) {
+            const int c = cy * cw_ + cx;
+            const int i0 = cell_i0_[cx], i1 = cell_i0_[cx + 1], j0 = cell_j0_[cy], j1 = cell_j0_[cy + 1];
+            cell_row_off_[c] = cell_row_cdf_.size();
+            cell_row_cdf_.push_back(0.0);
+            for (int j = j0; j < j1; ++j) {
+                const double* cdf = &conditional_cdf_[size_t(j) * (w_ + 1)];
+                cell_row_cdf_.push_back(cell_row_cdf_.back() + (cdf[i1] - cdf[i0]));
+            }
+            cell_mass_[c] = cell_row_cdf_.back() / total_;
+            cell_omega_[c] = (i1 - i0) * (2 * kPi / w_) * (std::cos(j0 * kPi / h_) - std::cos(j1 * kPi / h_));
+            // Centre = the direction of the uv centre; angular radius = the largest angle to the cell's
+            // corners and edge midpoints (+1 % and 1e-4 rad of slack).
+            double* d = &cell_dir_[size_t(c) * 3];
+            const double u0 = double(i0) / w_, u1 = double(i1) / w_, v0 = double(j0) / h_, v1 = double(j1) / h_;
+            env_dir(0.5 * (u0 + u1), 0.5 * (v0 + v1), d);
+            double min_cos = 1;
+            for (double fu : {0.0, 0.5, 1.0})
+                for (double fv : {0.0, 0.5, 1.0}) {
+                    double q[3];
+                    env_dir(u0 + fu * (u1 - u0), v0 + fv * (v1 - v0), q);
+                    min_cos = std::min(min_cos, d[0] * q[0] + d[1] * q[1] + d[2] * q[2]);
+                }
+            double rad = std::acos(std::clamp(min_cos, -1.0, 1.0)) * 1.01 + 1e-4;
+            rad = std::min(rad, kPi);
+            cell_rad_[c] = rad, cell_cos_rad_[c] = std::cos(rad), cell_sin_rad_[c] = std::sin(rad);
+        }
 }
 
 // First index i in [0, n) with cdf[i + 1] > t (the upper_bound), from the guide; never an empty bin.
@@ -158,6 +224,54 @@ double EnvDistribution::sample_uv(double u1, double u2, double dir[3], double& u
     double s = u1 * cdf[w_];
     int i = invert_cdf(cdf, &conditional_guide_[size_t(j) * w_], w_, s);
     double du = std::clamp((s - cdf[i]) / (cdf[i + 1] - cdf[i]), 0.0, 1.0 - 1e-12);
+    return place(i, j, du, dv, dir, u, v);
+}
+
+// Last index i in [lo, hi) with cdf[i] <= t (cdf non-decreasing; the bin [cdf[i], cdf[i+1]) holds t),
+// stepping back off empty bins.
+static inline int search_cdf(const double* cdf, int lo, int hi, double t) {
+    int a = lo, b = hi - 1;
+    while (a < b) {
+        int m = (a + b + 1) / 2;
+        if (cdf[m] <= t) a = m;
+        else b = m - 1;
+    }
+    while (a > lo && cdf[a + 1] - cdf[a] <= 0) --a;
+    return a;
+}
+
+double EnvDistribution::sample_in_cell(int c, double u1, double u2, double dir[3], double& u, double& v) const {
+    const int cx = c % cw_, cy = c / cw_;
+    const int i0 = cell_i0_[cx], i1 = cell_i0_[cx + 1], j0 = cell_j0_[cy], j1 = cell_j0_[cy + 1];
+    const double* rc = &cell_row_cdf_[cell_row_off_[size_t(c)]]; // j1 - j0 + 1 entries
+    const int nr = j1 - j0;
+    if (rc[nr] <= 0) return 0;
+    double t = u2 * rc[nr];
+    int r = search_cdf(rc, 0, nr, t);
+    double dv = std::clamp((t - rc[r]) / (rc[r + 1] - rc[r]), 0.0, 1.0 - 1e-12);
+    const int j = j0 + r;
+    const double* cdf = &conditional_cdf_[size_t(j) * (w_ + 1)];
+    double s = cdf[i0] + u1 * (cdf[i1] - cdf[i0]);
+    int i = search_cdf(cdf, i0, i1, s);
+    double du = std::clamp((s - cdf[i]) / (cdf[i + 1] - cdf[i]), 0.0, 1.0 - 1e-12);
+    return place(i, j, du, dv, dir, u, v);
+}
+
+int EnvDistribution::cell_of_uv(double u, double v) const {
+    int i = std::clamp(int(u * w_), 0, w_ - 1), j = std::clamp(int(v * h_), 0, h_ - 1);
+    // cell_i0_ is i·w_/cw_ rounded down, so pixel i is in cell floor((i·cw_ + cw_ - 1) / w_)... search it.
+    int cx = std::min(cw_ - 1, int(int64_t(i) * cw_ / w_));
+    while (cx > 0 && cell_i0_[cx] > i) --cx;
+    while (cx < cw_ - 1 && cell_i0_[cx + 1] <= i) ++cx;
+    int cy = std::min(ch_ - 1, int(int64_t(j) * ch_ / h_));
+    while (cy > 0 && cell_j0_[cy] > j) --cy;
+    while (cy < ch_ - 1 && cell_j0_[cy + 1] <= j) ++cy;
+    return cy * cw_ + cx;
+}
+
+// Pixel (i, j), offsets (du, dv) in [0,1): φ uniform, cos θ uniform between the row's edges (uniform in
+// solid angle inside the pixel); returns the pixel's pdf.
+double EnvDistribution::place(int i, int j, double du, double dv, double dir[3], double& u, double& v) const {
     u = (i + du) / w_;
     double phi = (u - 0.5) * 2 * kPi;
     // Uniform in solid angle inside the pixel: cos θ uniform between the row's edges.
@@ -234,7 +348,8 @@ struct Shader {
     const EnvImage& img;
     const EnvDistribution& dist;
     Lobes lobes;
-    bool power = true; // MIS heuristic: power (β = 2) or balance
+    bool power = true;   // MIS heuristic: power (β = 2) or balance
+    bool window = true;  // env_sampling = window (EnvWindow) or global
 };
 
 // Per-sphere constants of the model.
@@ -261,14 +376,61 @@ MatConst mat_const(const Material& mat, Lobes lobes) {
     return c;
 }
 
+// The environment strategy's distribution for one pixel and sphere: the environment distribution
+// (∝ luminance) reweighted per coarse cell by a window K_c that approximates the rest of the integrand,
+// f·(n·l), over the directions the pixel's hits can see:
+//   K_c = k̄_d · cos⁺(∠(c, n₀) − δ_c − δ_p)          diffuse: Lambert's cosine, dilated
+//       + F̄ · S_c / Σ S Ω   where cos⁺(…) > 0       specular, normalised to carry F̄ over the sphere
+//   S_c = 1 (env_window = hemisphere, default)  or  D(cos(γ/2)), γ = max(0, ∠(c, r₀) − δ_c − 2δ_p) (lobe)
+// with n₀, r₀ the normal and mirror direction at the centre of the pixel's hits on the sphere, δ_p the
+// largest angle from n₀ to the normals seen in the pixel (×1.1 + 0.01), δ_c the cell's angular radius,
+// k̄_d and F̄ the channel means of the Lambert term and of Schlick at n₀·v, Ω the cells' solid angles.
+// ∫ k̄_d cos dl = π k̄_d is the diffuse albedo and the specular term integrates to F̄, so the two terms
+// carry the lobes' relative energy. (Without the normalisation, the dilated D plateau held ~50x the
+// lobe's energy and starved the diffuse lobe of dielectrics.)
+// Sampling: a cell with probability P_c = K_c W_c / Σ K W (W_c: the cell's share of the luminance),
+// then a pixel of it from the global distribution, so pdf_window(ω) = pdf(ω) · K_c / Σ K W. It is a
+// mixture with the global distribution, weight ε = 0.1 (defensive sampling, Hesterberg 1995): every
+// direction with radiance keeps a non-zero env pdf (a 5e4 sun outside a badly estimated window is
+// still sampled; MIS with the BRDF strategy keeps the estimator unbiased whatever the window is, the
+// window only decides how well the product L·f·cos is followed). The window is a deterministic
+// function of the pixel and sphere, the same for every lighting seed.
+// Measured (noise floor between seeds: mean FLIP / relative RMSE, roughness_sweep 528x96, 1024 spp):
+//   studio:  global distribution 0.0117 / 1.65 %; window (64x32 cells, unnormalised lobe) 0.0099 / 1.20 %;
+//            + silhouette boost 0.0073 / 0.90 %; 128x64 cells 0.0067 / 0.83 %; normalised lobe
+//            0.0060 / 0.72 %; normalised hemisphere 0.0060 / 0.89 %; lobe + mis_compensation 1:
+//            0.0056 / 0.68 %
+//   sunrise: normalised lobe 0.0083 / 0.61 %; hemisphere 0.0084 / 0.62 %; lobe + mis_compensation 1:
+//            0.0107 / 0.85 % (the compensated strategy leaves the bright sky to cosine sampling)
+//   furnace (constant:1, 4096 spp): lobe 0.15 % rel. RMSE; hemisphere 0.046 %: in a constant
+//   environment the lobe window competes with the exact GGX sampling instead of helping it (a metal
+//   r = 0.25 furnace sphere: 0.31 % vs 0.07 % for the global distribution), the hemisphere does not.
+//   Hence hemisphere by default: the same FLIP, the only criterion not met with margin, and no
+//   pathological case. A Lambert sphere (lobes=diffuse, studio, 128 px, 256 spp): 2.36 % -> 1.04 %.
+// (Product sampling by per-region light distributions: e.g. Conty Estevez & Kulla 2018, "Importance
+// Sampling of Many Lights with Adaptive Tree Splitting"; Clarberg et al. 2005 for the product of
+// environment and BRDF.)
+constexpr double kWindowDefensive = 0.1;
+struct EnvWindow {
+    bool valid = false;
+    std::vector<double> marginal;    // ch + 1
+    std::vector<double> conditional; // ch * (cw + 1)
+    std::vector<double> factor;      // cw * ch: K_c / Σ K W (pdf_window = pdf · factor)
+    std::vector<double> spec_scratch;
+    double pdf(const EnvDistribution& d, double u, double v, double pdf_global) const {
+        if (!valid) return pdf_global;
+        return pdf_global * ((1 - kWindowDefensive) * factor[size_t(d.cell_of_uv(u, v))] + kWindowDefensive);
+    }
+};
+
 // Per-pixel scramble seeds of the lighting dimensions.
 struct LightSeeds {
     uint32_t brdf, select, env;
 };
 
 // Shades one camera sub-sample: world normal n, direction to the viewer v; adds into out[3].
-void shade(const Shader& S, const MatConst& M, V3 n, V3 v, const LightSeeds& seeds, uint32_t k, double out[3],
-           long& fetches) {
+void shade(const Shader& S, const MatConst& M, const EnvWindow& win, V3 n, V3 v, const LightSeeds& seeds, uint32_t k,
+           double out[3], long& fetches) {
     // Local frame (Duff et al. 2017).
     double sign = std::copysign(1.0, n.z);
     double a = -1.0 / (sign + n.z), b = n.x * n.y * a;
@@ -361,7 +523,7 @@ void shade(const Shader& S, const MatConst& M, V3 n, V3 v, const LightSeeds& see
             V3 lw = to_world(l);
             double lwd[3] = {lw.x, lw.y, lw.z}, u, vv, L[3];
             S.dist.to_uv(lwd, u, vv);
-            double pe = S.dist.pdf_uv(u, vv);
+            double pe = win.pdf(S.dist, u, vv, S.dist.pdf_uv(u, vv));
             double w = S.power ? pb / (pb + pe * (pe / pb)) : pb / (pb + pe);
             S.img.lookup(u, vv, L);
             ++fetches;
@@ -371,9 +533,29 @@ void shade(const Shader& S, const MatConst& M, V3 n, V3 v, const LightSeeds& see
 
     // (b) Environment sampling.
     if (!S.dist.empty()) {
-        double e0, e1, dw[3], u, vv;
+        double e0, e1, dw[3], u, vv, pe = 0;
         reference::sobol_owen_2d(k, seeds.env, e0, e1);
-        double pe = S.dist.sample_uv(e0, e1, dw, u, vv);
+        if (!win.valid) pe = S.dist.sample_uv(e0, e1, dw, u, vv);
+        else {
+            // Mixture: e1 < ε picks the global distribution, else the window (e1 rescaled, as for the lobes).
+            double pg;
+            if (e1 < kWindowDefensive) pg = S.dist.sample_uv(e0, std::min(e1 / kWindowDefensive, 1.0 - 1e-16), dw, u, vv);
+            else {
+                double t = (e1 - kWindowDefensive) / (1 - kWindowDefensive);
+                const int cw = S.dist.cells_x(), ch = S.dist.cells_y();
+                // Cell row from the window's marginal, column from its conditional; the remainders place
+                // the sample inside the cell (stratification carries over).
+                double tr = std::min(t, 1.0 - 1e-16) * win.marginal[ch];
+                int cy = reference::search_cdf(win.marginal.data(), 0, ch, tr);
+                double rr = std::clamp((tr - win.marginal[cy]) / (win.marginal[cy + 1] - win.marginal[cy]), 0.0, 1.0 - 1e-12);
+                const double* cc = &win.conditional[size_t(cy) * (cw + 1)];
+                double tc = e0 * cc[cw];
+                int cx = reference::search_cdf(cc, 0, cw, tc);
+                double rc = std::clamp((tc - cc[cx]) / (cc[cx + 1] - cc[cx]), 0.0, 1.0 - 1e-12);
+                pg = S.dist.sample_in_cell(cy * cw + cx, rc, rr, dw, u, vv);
+            }
+            pe = pg > 0 ? win.pdf(S.dist, u, vv, pg) : 0.0;
+        }
         if (pe > 0) {
             V3 lw{dw[0], dw[1], dw[2]};
             V3 ll{dot(lw, t), dot(lw, bt), dot(lw, n)};
@@ -389,13 +571,32 @@ void shade(const Shader& S, const MatConst& M, V3 n, V3 v, const LightSeeds& see
     }
 }
 
-const char* kEstimator =
-    "sub-pixel positions: an Owen-scrambled Sobol pattern per pixel keyed by pixel_pattern (not by the "
-    "lighting seed); lighting per position: MIS (power heuristic, 1 sample each) of "
-    "BRDF sampling [mixture of GGX VNDF (Heitz 2018) with p_s = F/(F+diffuse) clamped to [0.1,0.9], and "
-    "cosine hemisphere] and environment sampling [piecewise-constant equirect distribution ~ 3x3-max "
-    "luminance * solid angle, guide-table CDF inversion], whole BRDF per sample; alpha < 1e-4 treated as a "
-    "mirror delta F(n.v) L(reflect); bilinear env lookups; no inter-sphere occlusion";
+std::string format_g(double v) {
+    char b[32];
+    std::snprintf(b, sizeof b, "%g", v);
+    return b;
+}
+
+std::string estimator_description(bool window, bool lobe_window, double compensation, int silhouette_boost) {
+    std::string env = std::string("environment sampling [piecewise-constant equirect distribution ~ ") +
+                      (compensation > 0 ? "max(0, 3x3-max luminance - " + format_g(compensation) +
+                                              " x mean luminance) (MIS compensation, Karlik et al. 2019)"
+                                        : std::string("3x3-max luminance")) +
+                      " * solid angle, guide-table CDF inversion";
+    if (window)
+        env += std::string("; per pixel and sphere reweighted by 128x64 cells with a window ~ dilated cosine (diffuse) + ") +
+               (lobe_window ? "GGX D about the mirror direction" : "flat hemisphere") +
+               " (specular), mixed with 10 % of the unwindowed distribution";
+    env += "]";
+    return "sub-pixel positions: an Owen-scrambled Sobol pattern per pixel keyed by pixel_pattern (not by the "
+           "lighting seed); lighting per position: MIS (power heuristic, 1 sample each) of "
+           "BRDF sampling [mixture of GGX VNDF (Heitz 2018) with p_s = F/(F+diffuse) clamped to [0.1,0.9], and "
+           "cosine hemisphere] and " + env +
+           ", whole BRDF per sample; adaptive lighting-sample counts from a discarded pilot, silhouette pixels at least " +
+           std::to_string(silhouette_boost) +
+           "x the mean; alpha < 1e-4 treated as a mirror delta F(n.v) L(reflect); bilinear env lookups; no "
+           "inter-sphere occlusion";
+}
 
 // Spheres that any ray through pixel (x, y) can hit (conservative), so the per-sample intersection
 // loop skips the others. Orthographic: distance of the centre from the pixel-centre ray ≤ radius +
@@ -461,6 +662,108 @@ bool intersect_candidates(const Scene& scene, const std::vector<int>& cand, Vec3
     return true;
 }
 
+// Builds the window of pixel (x, y) for sphere `si` (EnvWindow above). n₀, δ_p from a 5x5 grid of rays
+// over the pixel: the mean of the hit normals, and the largest angle from it (×1.1 + 0.01); where some
+// rays miss, the grid's hits alone (silhouette pixels: their hits are near-grazing, the spread is wide).
+void build_window(const Scene& scene, int W, int H, int x, int y, int si, const MatConst& M, const EnvDistribution& dist,
+                  bool spec_lobe_window, EnvWindow& win) {
+    win.valid = false;
+    if (dist.empty()) return;
+    const Sphere& sp = scene.spheres[size_t(si)];
+    V3 ns[25], vs[25];
+    int nh = 0;
+    for (int gy = 0; gy < 5; ++gy)
+        for (int gx = 0; gx < 5; ++gx) {
+            Vec3f o, d;
+            camera_ray(scene, W, H, x + (gx + 0.5) / 5, y + (gy + 0.5) / 5, o, d);
+            double oc[3];
+            double t = intersect_sphere(sp, o, d, oc);
+            if (!std::isfinite(t)) continue;
+            ns[nh] = normalize(V3{oc[0] + t * d.x, oc[1] + t * d.y, oc[2] + t * d.z});
+            vs[nh] = normalize(V3{-d.x, -d.y, -d.z});
+            ++nh;
+        }
+    if (nh == 0) {
+        // Only sub-pixel slivers hit: take the pixel-centre ray's closest approach (a near-grazing normal).
+        Vec3f o, d;
+        camera_ray(scene, W, H, x + 0.5, y + 0.5, o, d);
+        V3 dd = normalize(V3{d.x, d.y, d.z});
+        V3 c = V3{sp.center.x - o.x, sp.center.y - o.y, sp.center.z - o.z};
+        V3 p = dot(c, dd) * dd + (-1.0) * c; // closest point of the ray, relative to the centre
+        if (dot(p, p) <= 0) return;
+        ns[0] = normalize(p), vs[0] = (-1.0) * dd, nh = 1;
+    }
+    V3 n0{0, 0, 0}, v0{0, 0, 0};
+    for (int i = 0; i < nh; ++i) n0 = n0 + ns[i], v0 = v0 + vs[i];
+    n0 = normalize(n0), v0 = normalize(v0);
+    double min_cos = 1;
+    for (int i = 0; i < nh; ++i) min_cos = std::min(min_cos, dot(ns[i], n0));
+    double dp = std::acos(std::clamp(min_cos, -1.0, 1.0)) * 1.1 + 0.01;
+    if (nh < 25) dp = std::max(dp, 0.35); // partially covered: rays between the grid's reach the rim
+    const double nv = std::max(dot(n0, v0), kMinNdotV);
+    V3 r0 = 2 * nv * n0 + (-1.0) * v0;
+    double kd = 0, fbar = 0;
+    for (int i = 0; i < 3; ++i) kd += M.kd[i] / 3, fbar += (M.cont_spec ? model::f_schlick(M.f0[i], nv) : 0.0) / 3;
+    const int cw = dist.cells_x(), ch = dist.cells_y();
+    win.marginal.assign(size_t(ch) + 1, 0.0);
+    win.conditional.assign(size_t(ch) * (cw + 1), 0.0);
+    win.factor.assign(size_t(cw) * ch, 0.0);
+    // cos(max(0, a − δ)) from cos a, for δ = cell radius + spread (cos/sin precomputed): 1 inside δ.
+    const double cdp = std::cos(dp), sdp = std::sin(dp), c2p = std::cos(2 * dp), s2p = std::sin(2 * dp);
+    auto cos_minus = [](double ca, double cd, double sd) {
+        if (ca >= cd) return 1.0;
+        double sa = std::sqrt(std::max(0.0, 1 - ca * ca));
+        return ca * cd + sa * sd;
+    };
+    double total = 0, spec_norm = 0;
+    std::vector<double>& spec = win.spec_scratch;
+    spec.assign(size_t(cw) * ch, 0.0);
+    for (int cy = 0; cy < ch; ++cy) {
+        for (int cx = 0; cx < cw; ++cx) {
+            const int c = cy * cw + cx;
+            double K = 0, ks = 0;
+            {
+                const double* cd = dist.cell_centre(c);
+                const V3 dir{cd[0], cd[1], cd[2]};
+                const double ccr = dist.cell_cos_radius(c), scr = dist.cell_sin_radius(c);
+                // δ = δ_c + δ_p (angles add: cos/sin of the sum), and δ_c + 2δ_p for the mirror direction.
+                const double cd1 = ccr * cdp - scr * sdp, sd1 = scr * cdp + ccr * sdp;
+                const double cd2 = ccr * c2p - scr * s2p, sd2 = scr * c2p + ccr * s2p;
+                const double rc = dist.cell_radius(c);
+                // The angle-sum cosines are those of δ only while δ < π; beyond, every direction is within δ.
+                const double cb = rc + dp >= kPi ? 1.0 : cos_minus(dot(dir, n0), cd1, sd1);
+                if (cb > 0) { // else below the dilated horizon (the angle minus δ exceeds 90 degrees)
+                    K = kd * cb;
+                    if (fbar > 0) {
+                        double cg = rc + 2 * dp >= kPi ? 1.0 : cos_minus(dot(dir, r0), cd2, sd2);
+                        double ch_half = std::sqrt(std::max(0.0, 0.5 * (1 + cg)));
+                        ks = spec_lobe_window ? model::d_ggx(ch_half, M.alpha) : 1.0;
+                        spec_norm += ks * dist.cell_solid_angle(c);
+                    }
+                }
+            }
+            win.factor[size_t(c)] = K;
+            spec[size_t(c)] = ks;
+        }
+    }
+    // The specular term normalised to carry F̄ over the sphere, like the diffuse term's π k̄_d.
+    const double sn = spec_norm > 0 ? fbar / spec_norm : 0.0;
+    for (int cy = 0; cy < ch; ++cy) {
+        double* cond = &win.conditional[size_t(cy) * (cw + 1)];
+        for (int cx = 0; cx < cw; ++cx) {
+            const int c = cy * cw + cx;
+            double K = win.factor[size_t(c)] + sn * spec[size_t(c)];
+            win.factor[size_t(c)] = K;
+            cond[cx + 1] = cond[cx] + K * dist.cell_mass(c);
+        }
+        win.marginal[size_t(cy) + 1] = win.marginal[size_t(cy)] + cond[cw];
+        total += cond[cw];
+    }
+    if (!(total > 0) || !std::isfinite(total)) return;
+    for (double& f : win.factor) f /= total;
+    win.valid = true;
+}
+
 } // namespace
 
 ReferenceRender render_reference_full(const TestSpec& spec, const Environment* env_in) {
@@ -472,18 +775,24 @@ ReferenceRender render_reference_full(const TestSpec& spec, const Environment* e
     int pattern = o.get_int("pixel_pattern", 0);
     const bool adaptive = o.get_int("adaptive", 1) != 0;
     const int adaptive_cap = o.get_int("adaptive_cap", 16);
+    const int silhouette_boost = o.get_int("silhouette_boost", 16);
     const int positions = std::clamp(o.get_int("positions", std::max(1, spp / 4)), 1, std::max(1, spp));
     int threads = o.get_int("threads", 0);
     double rot = o.get_double("env_rotation", 0.0);
     std::string lobes_s = o.get_choice("lobes", "all", {"all", "diffuse", "specular"});
     std::string mis = o.get_choice("mis", "power", {"power", "balance"});
+    std::string env_sampling = o.get_choice("env_sampling", "window", {"window", "global"});
+    std::string env_window = o.get_choice("env_window", "hemisphere", {"hemisphere", "lobe"});
+    const double mis_compensation = o.get_double("mis_compensation", 0.0);
+    if (mis_compensation < 0) throw UsageError("option 'mis_compensation': must be >= 0");
     if (spp < 1) throw UsageError("option 'spp': must be >= 1");
     if (threads < 0) throw UsageError("option 'threads': must be >= 0");
+    if (silhouette_boost < 1) throw UsageError("option 'silhouette_boost': must be >= 1");
     Lobes lobes = lobes_s == "diffuse" ? Lobes::diffuse : lobes_s == "specular" ? Lobes::specular : Lobes::all;
 
     Environment env = env_in ? *env_in : load_environment(spec.env);
     if (o.has("env_rotation")) env.rotation_deg = float(rot);
-    EnvDistribution dist(env);
+    EnvDistribution dist(env, mis_compensation);
     cv::Mat equirect = env.equirect.isContinuous() ? env.equirect : env.equirect.clone();
     EnvImage img(equirect);
 
@@ -495,7 +804,7 @@ ReferenceRender render_reference_full(const TestSpec& spec, const Environment* e
     cv::Mat image(H, W, CV_32FC3, cv::Scalar(0, 0, 0));
     cv::Mat coverage(H, W, CV_32FC1, cv::Scalar(0));
     std::vector<long> row_fetches(H, 0);
-    Shader S{img, dist, lobes, mis == "power"};
+    Shader S{img, dist, lobes, mis == "power", env_sampling == "window"};
     std::vector<MatConst> mats;
     for (const auto& sp : scene.spheres) mats.push_back(mat_const(sp.material, lobes));
     const uint32_t seed_hash = reference::hash_u32(uint32_t(seed) * 0x9e3779b9u + 0x85ebca6bu);
@@ -518,6 +827,8 @@ ReferenceRender render_reference_full(const TestSpec& spec, const Environment* e
                                reference::hash_u32(pix_seed ^ 0x7b3f9a11u)};
         double acc[3] = {0, 0, 0}, s1 = 0, s2 = 0;
         int hits = 0;
+        std::vector<EnvWindow> wins(cand.size());
+        std::vector<char> win_built(cand.size(), 0);
         if (!cand.empty())
             for (int k = 0; k < P; ++k) {
                 double sx, sy;
@@ -529,10 +840,16 @@ ReferenceRender render_reference_full(const TestSpec& spec, const Environment* e
                 if (!intersect_candidates(scene, cand, o3, d3, sph, nrm)) continue;
                 ++hits;
                 V3 v = normalize({-d3.x, -d3.y, -d3.z});
+                // This sphere's window, built at its first hit in the pixel.
+                size_t ci = size_t(std::find(cand.begin(), cand.end(), sph) - cand.begin());
+                if (S.window && !win_built[ci]) {
+                    build_window(scene, W, H, x, y, sph, mats[size_t(sph)], dist, env_window == "lobe", wins[ci]);
+                    win_built[ci] = 1;
+                }
                 double pos[3] = {0, 0, 0};
                 for (int m = 0; m < M; ++m) {
                     double one[3] = {0, 0, 0};
-                    shade(S, mats[sph], nrm, v, seeds, uint32_t(k) * uint32_t(M) + uint32_t(m), one, fetches);
+                    shade(S, mats[sph], wins[ci], nrm, v, seeds, uint32_t(k) * uint32_t(M) + uint32_t(m), one, fetches);
                     double yl = 0.2126 * one[0] + 0.7152 * one[1] + 0.0722 * one[2];
                     s1 += yl, s2 += yl * yl;
                     for (int i = 0; i < 3; ++i) pos[i] += one[i];
@@ -564,8 +881,14 @@ ReferenceRender render_reference_full(const TestSpec& spec, const Environment* e
     // σ_L (per-lighting-sample standard deviation of the luminance over its hits) and its value μ; the
     // pixel's relative variance is ≈ c·σ_L²/(P·M·(μ² + 0.01)) at cost c·P·M (c = coverage), so counts
     // M ∝ σ_L/√(μ² + 0.01) (3x3 max, so a ring of noisy pixels is covered whole) minimise the summed
-    // relative variance for the same work — partially covered silhouette pixels, whose few hits carry
-    // all the lighting noise of a dim pixel, get many more. Clamped to [M̄/4, 16 M̄], M̄ = spp/P.
+    // relative variance for the same work. Clamped to [M̄/4, adaptive_cap·M̄], M̄ = spp/P.
+    // Silhouette pixels (pilot coverage < 1) get at least silhouette_boost·M̄ (default 16): the mean FLIP
+    // between seeds is not the relative MSE — FLIP's edge detector turns a silhouette pixel's noise into
+    // error on both sides of the edge, background included. Measured on the studio sweep at 1024 spp:
+    // the silhouette ring (partially covered pixels and the background next to them) was half the mean
+    // FLIP (0.0099); raising adaptive_cap to 64 changed nothing (these pixels' σ_L/μ is not larger
+    // than their neighbours'), the boost took the FLIP to 0.0073 for 1.55x the time — better than the
+    // ~0.0083 that 1.55x the samples everywhere would give.
     // The pilot's samples are then discarded: the counts depend on the pilot only, the main samples
     // are independent of it, so each pixel's estimate stays unbiased.
     const int m_mean = std::max(1, int(std::lround(double(spp) / positions)));
@@ -573,6 +896,7 @@ ReferenceRender render_reference_full(const TestSpec& spec, const Environment* e
     long pilot_samples = 0;
     if (adaptive) {
         std::vector<double> r(size_t(W) * H, -1.0);
+        std::vector<char> partial(size_t(W) * H, 0);
         const uint32_t pilot_hash = reference::hash_u32(seed_hash ^ 0x3c6ef372u);
         const int pilot_pos = std::min(positions, 32);
         std::atomic<long> pilot_n{0};
@@ -586,6 +910,7 @@ ReferenceRender render_reference_full(const TestSpec& spec, const Environment* e
                                            reference::hash_u32(pilot_hash ^ pix), cand, f);
                 double mu = po.coverage * po.lum_mean;
                 r[size_t(y) * W + x] = std::sqrt(po.lum_var) / std::sqrt(mu * mu + 0.01);
+                if (po.coverage < 1) partial[size_t(y) * W + x] = 1; // silhouette (or a sliver the pilot missed)
                 pilot_n += long(std::lround(po.coverage * pilot_pos)) * 2;
             }
         });
@@ -610,6 +935,7 @@ ReferenceRender render_reference_full(const TestSpec& spec, const Environment* e
             if (rm[i] < 0) continue; // no sphere can be hit: the count is irrelevant
             double c = mean_r > 0 ? m_mean * rm[i] / mean_r : m_mean;
             counts[i] = int(std::clamp(std::lround(c), long(std::max(1, m_mean / 4)), long(adaptive_cap) * m_mean));
+            if (partial[i]) counts[i] = std::max(counts[i], silhouette_boost * m_mean);
         }
     }
 
@@ -661,6 +987,9 @@ ReferenceRender render_reference_full(const TestSpec& spec, const Environment* e
         {"threads", threads},
         {"lobes", lobes_s},
         {"mis", mis},
+        {"env_sampling", env_sampling},
+        {"env_window", env_window},
+        {"mis_compensation", mis_compensation},
         {"env", {{"spec", env.spec.empty() ? spec.env : env.spec},
                  {"content_hash", env.content_hash},
                  {"source_path", env.source_path},
@@ -668,7 +997,8 @@ ReferenceRender render_reference_full(const TestSpec& spec, const Environment* e
                  {"height", env.equirect.rows},
                  {"negatives_clamped", env.negatives_clamped},
                  {"rotation_deg", env.rotation_deg}}},
-        {"estimator", kEstimator},
+        {"estimator", estimator_description(env_sampling == "window", env_window == "lobe", mis_compensation,
+                                             adaptive ? silhouette_boost : 1)},
         {"texture_fetches_per_pixel", r.texture_fetches_per_pixel},
         {"time_s", total_s},
     };

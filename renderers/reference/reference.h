@@ -48,6 +48,14 @@
 //           method: O(1) expected, still monotone, so the Sobol stratification carries over to the
 //           environment — an alias table would lose it); the per-pixel pdf is stored (float) and shared by
 //           sample() and pdf(), so the estimator sees exactly the density it samples.
+//           Windowed (env_sampling = window, the default): per pixel and sphere, that distribution is
+//           reweighted per coarse cell (128x64 cells of the equirect) by a window approximating the rest
+//           of the integrand over the hemisphere the pixel's normals see — the dilated cosine for the
+//           diffuse lobe plus, for the specular lobe, a flat hemisphere (env_window = hemisphere, default)
+//           or GGX's D about the mirror direction (env_window = lobe) — and mixed with 10 % of the plain
+//           distribution (defensive), so no direction with radiance has a zero env pdf. Rationale and
+//           measurements: reference.cpp (EnvWindow) and CONVERGENCE.md. mis_compensation = κ samples
+//           max(0, Y − κȲ) instead of Y (Karlík et al. 2019); default 0 (measured worse on sunrise).
 //   * Mirror limit: for α < 1e-4 (roughness < 0.01, in practice r = 0) the specular lobe is the delta
 //     F(n·v)·L(reflect(v)) — one lookup, exact — and MIS (a)+(b) covers the diffuse lobe only.
 //     No α clamp anywhere else.
@@ -70,7 +78,9 @@
 //   lighting random numbers), pixel_pattern (default 0; the sub-pixel positions), positions (default
 //   spp/4), adaptive (default 1), adaptive_cap (default 16), mis = power|balance, threads (0 = hardware
 //   concurrency), env_rotation (degrees about +Y), lobes = all|diffuse|specular (debug/test: evaluate
-//   only that lobe of the model).
+//   only that lobe of the model), env_sampling = window|global, env_window = hemisphere|lobe,
+//   mis_compensation (default 0), silhouette_boost (default 16: lighting samples of silhouette pixels
+//   at least this many times the mean, with adaptive = 1).
 #pragma once
 #include <cstdint>
 #include <optional>
@@ -127,7 +137,9 @@ namespace reference {
 // Piecewise-constant environment distribution (see above), in WORLD directions (rotation applied).
 class EnvDistribution {
   public:
-    explicit EnvDistribution(const Environment& env);
+    // compensation κ ≥ 0: the sampled luminance is max(0, Y − κ·Ȳ), Ȳ the environment's mean luminance
+    // over the sphere (MIS compensation, Karlík et al. 2019; see reference.cpp). 0: plain luminance.
+    explicit EnvDistribution(const Environment& env, double compensation = 0.0);
     bool empty() const { return total_ <= 0; }
     // Samples a world direction from (u1, u2) in [0,1)²; returns its solid-angle pdf (0: no sample).
     double sample(double u1, double u2, double dir[3]) const;
@@ -138,8 +150,34 @@ class EnvDistribution {
     void to_uv(const double dir[3], double& u, double& v) const;
     double pdf_uv(double u, double v) const;
 
+    // Coarse cells (at most 64x32, each a block of equirect pixels) for the per-pixel windowed
+    // distribution (reference.cpp, EnvWindow): sampling cell c with probability P_c and then a pixel of
+    // c from this distribution restricted to c gives the solid-angle pdf  pdf(ω) · P_c / (W_c / total),
+    // W_c the cell's mass. The window only rescales whole cells, so pdf() and a per-cell factor give
+    // any windowed pdf exactly.
+    int cells_x() const { return cw_; }
+    int cells_y() const { return ch_; }
+    int cell_of_uv(double u, double v) const;
+    double cell_mass(int c) const { return cell_mass_[size_t(c)]; } // W_c / total, sums to 1
+    const double* cell_centre(int c) const { return &cell_dir_[size_t(c) * 3]; } // world direction
+    double cell_solid_angle(int c) const { return cell_omega_[size_t(c)]; }
+    double cell_radius(int c) const { return cell_rad_[size_t(c)]; } // angular radius (rad)
+    double cell_cos_radius(int c) const { return cell_cos_rad_[size_t(c)]; } // cos of its angular radius
+    double cell_sin_radius(int c) const { return cell_sin_rad_[size_t(c)]; }
+    // Samples a pixel of cell c from (u1, u2) (u2 picks the row, u1 the column); returns pdf(ω), the
+    // UNwindowed pdf of the direction (0: empty cell).
+    double sample_in_cell(int c, double u1, double u2, double dir[3], double& u, double& v) const;
+
   private:
+    double place(int i, int j, double du, double dv, double dir[3], double& u, double& v) const;
     int w_ = 0, h_ = 0;
+    int cw_ = 0, ch_ = 0;                 // cells
+    std::vector<int> cell_i0_, cell_j0_;  // cw_ + 1, ch_ + 1 pixel bounds
+    std::vector<double> cell_mass_;       // cw_ * ch_, fraction of total
+    std::vector<double> cell_dir_;        // cw_ * ch_ * 3
+    std::vector<double> cell_rad_, cell_cos_rad_, cell_sin_rad_, cell_omega_;
+    std::vector<double> cell_row_cdf_;    // per cell: CDF over its pixel rows of the row masses within the cell
+    std::vector<size_t> cell_row_off_;    // offset of each cell's CDF (rows + 1 entries)
     double total_ = 0;
     double rot_c_ = 1, rot_s_ = 0; // env -> world rotation by +rotation_deg about +Y
     std::vector<double> marginal_cdf_;    // h_ + 1

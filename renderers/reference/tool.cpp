@@ -1,8 +1,9 @@
 // iblcheck_reference_tool: renders one reference image (a golden) and its metadata.
 //   iblcheck_reference_tool --scene S --env E [--spp N] [--seed K] [--threads T] [--set key=value]...
-//                           --out FILE.exr [--meta FILE.json] [--noise-floor] [--command "..."]
+//                           --out FILE.exr [--meta FILE.json] [--noise-floor [--tiles WxH]] [--command "..."]
 // --noise-floor renders a second image with seed K+1 and records the relative RMSE between the two
-// (reference.h, measure_noise_floor); the golden written is the seed-K image.
+// (reference.h, measure_noise_floor); the golden written is the seed-K image. --tiles WxH also prints the
+// noise floor per WxH tile (48x48 = one sphere of the roughness sweep), to see where the noise is.
 #include <OpenImageIO/imageio.h>
 
 #include <chrono>
@@ -34,6 +35,7 @@ int main(int argc, char** argv) {
         spec.method = "reference";
         std::string out_path, meta_path, command;
         bool noise = false;
+        int tile_w = 0, tile_h = 0;
         int spp = kReferenceDefaultSpp, seed = 0;
         for (int i = 1; i < argc; ++i) {
             std::string a = argv[i];
@@ -53,6 +55,11 @@ int main(int argc, char** argv) {
             else if (a == "--meta") meta_path = next();
             else if (a == "--noise-floor") noise = true;
             else if (a == "--command") command = next();
+            else if (a == "--tiles") {
+                std::string t = next();
+                if (std::sscanf(t.c_str(), "%dx%d", &tile_w, &tile_h) != 2 || tile_w < 1 || tile_h < 1)
+                    throw UsageError("--tiles: expected WxH, e.g. 48x48, got '" + t + "'");
+            }
             else throw UsageError("unknown argument '" + a + "' (see the comment at the top of tool.cpp)");
         }
         if (out_path.empty()) throw UsageError("--out FILE.exr is required");
@@ -81,6 +88,27 @@ int main(int argc, char** argv) {
                                                 {"relative_rmse_met", nf.relative_rmse < 0.005},
                                                 {"met", flip < 0.002 && nf.relative_rmse < 0.005}};
             meta["seeds"] = {nf.seed_a, nf.seed_b};
+            if (tile_w > 0) {
+                FlipResult fr = compute_flip_hdr(nf.image_a, nf.image_b, FlipOptions{});
+                std::printf("noise floor per %dx%d tile: mean FLIP / relative RMSE (tiles with covered pixels)\n", tile_w,
+                            tile_h);
+                for (int ty = 0; ty < nf.image_a.rows; ty += tile_h) {
+                    for (int tx = 0; tx < nf.image_a.cols; tx += tile_w) {
+                        cv::Rect rc(tx, ty, std::min(tile_w, nf.image_a.cols - tx), std::min(tile_h, nf.image_a.rows - ty));
+                        double rel = relative_rmse(nf.image_a(rc), nf.image_b(rc), nf.coverage(rc));
+                        std::printf(" %.4f/%.2f%%", cv::mean(fr.errmap(rc))[0], 100 * rel);
+                    }
+                    std::printf("\n");
+                }
+                cv::Mat full = nf.coverage >= 1.0f, part = (nf.coverage > 0.0f) & (nf.coverage < 1.0f);
+                cv::Mat fullf, partf;
+                full.convertTo(fullf, CV_32F, 1.0 / 255), part.convertTo(partf, CV_32F, 1.0 / 255);
+                std::printf("fully covered pixels: %d, FLIP %.4f, relative RMSE %.2f%%; partially covered: %d, FLIP %.4f, "
+                            "relative RMSE %.2f%%\n",
+                            cv::countNonZero(full), cv::mean(fr.errmap, full)[0],
+                            100 * relative_rmse(nf.image_a, nf.image_b, fullf), cv::countNonZero(part),
+                            cv::mean(fr.errmap, part)[0], 100 * relative_rmse(nf.image_a, nf.image_b, partf));
+            }
             meta["provenance"] = nf.provenance_a;
         } else {
             meta["seeds"] = {seed};
