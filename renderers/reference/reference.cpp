@@ -259,7 +259,8 @@ double EnvDistribution::sample_in_cell(int c, double u1, double u2, double dir[3
 
 int EnvDistribution::cell_of_uv(double u, double v) const {
     int i = std::clamp(int(u * w_), 0, w_ - 1), j = std::clamp(int(v * h_), 0, h_ - 1);
-    // cell_i0_ is i·w_/cw_ rounded down, so pixel i is in cell floor((i·cw_ + cw_ - 1) / w_)... search it.
+    // Cell bounds are c·w_/cw_ rounded down: start from the proportional guess and step to the cell
+    // whose bounds hold the pixel.
     int cx = std::min(cw_ - 1, int(int64_t(i) * cw_ / w_));
     while (cx > 0 && cell_i0_[cx] > i) --cx;
     while (cx < cw_ - 1 && cell_i0_[cx + 1] <= i) ++cx;
