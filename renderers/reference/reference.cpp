@@ -168,9 +168,7 @@ EnvDistribution::EnvDistribution(const Environment& env, double compensation) {
     auto env_dir = [&](double u, double v, double d[3]) { // equirect uv -> world direction
         double phi = (u - 0.5) * 2 * kPi, th = v * kPi;
         double e[3] = {std::sin(th) * std::sin(phi), std::cos(th), -std::sin(th) * std::cos(phi)};
-        d[0] = rot_c_ * e[0] + rot_s_ * e[2];
-        d[1] = e[1];
-        d[2] = -rot_s_ * e[0] + rot_c_ * e[2];
+        env_to_world(e, d);
     };
     for (int cy = 0; cy < ch_; ++cy)
         for (int cx = 0; cx < cw_; ++cx) {
@@ -282,11 +280,15 @@ double EnvDistribution::place(int i, int j, double du, double dv, double dir[3],
     v = std::clamp(std::acos(ct) / kPi, double(j) / h_, std::nextafter(double(j + 1) / h_, 0.0));
     double st = std::sqrt(std::max(0.0, 1 - ct * ct));
     double e[3] = {st * std::sin(phi), ct, -st * std::cos(phi)};
-    // env -> world: R_y(+rotation)
-    dir[0] = rot_c_ * e[0] + rot_s_ * e[2];
-    dir[1] = e[1];
-    dir[2] = -rot_s_ * e[0] + rot_c_ * e[2];
+    env_to_world(e, dir);
     return pdf_[size_t(j) * w_ + i];
+}
+
+// env -> world: R_y(+rotation) (to_uv applies the inverse).
+void EnvDistribution::env_to_world(const double e[3], double d[3]) const {
+    d[0] = rot_c_ * e[0] + rot_s_ * e[2];
+    d[1] = e[1];
+    d[2] = -rot_s_ * e[0] + rot_c_ * e[2];
 }
 
 double EnvDistribution::sample(double u1, double u2, double dir[3]) const {
@@ -420,7 +422,11 @@ struct EnvWindow {
     std::vector<double> spec_scratch;
     double pdf(const EnvDistribution& d, double u, double v, double pdf_global) const {
         if (!valid) return pdf_global;
-        return pdf_global * ((1 - kWindowDefensive) * factor[size_t(d.cell_of_uv(u, v))] + kWindowDefensive);
+        return pdf_in_cell(d.cell_of_uv(u, v), pdf_global);
+    }
+    // The same where the direction's cell c is already known (a sample drawn from the window).
+    double pdf_in_cell(int c, double pdf_global) const {
+        return pdf_global * ((1 - kWindowDefensive) * factor[size_t(c)] + kWindowDefensive);
     }
 };
 
@@ -540,8 +546,11 @@ void shade(const Shader& S, const MatConst& M, const EnvWindow& win, V3 n, V3 v,
         else {
             // Mixture: e1 < ε picks the global distribution, else the window (e1 rescaled, as for the lobes).
             double pg;
-            if (e1 < kWindowDefensive) pg = S.dist.sample_uv(e0, std::min(e1 / kWindowDefensive, 1.0 - 1e-16), dw, u, vv);
-            else {
+            int cell;
+            if (e1 < kWindowDefensive) {
+                pg = S.dist.sample_uv(e0, std::min(e1 / kWindowDefensive, 1.0 - 1e-16), dw, u, vv);
+                cell = pg > 0 ? S.dist.cell_of_uv(u, vv) : 0;
+            } else {
                 double t = (e1 - kWindowDefensive) / (1 - kWindowDefensive);
                 const int cw = S.dist.cells_x(), ch = S.dist.cells_y();
                 // Cell row from the window's marginal, column from its conditional; the remainders place
@@ -553,9 +562,10 @@ void shade(const Shader& S, const MatConst& M, const EnvWindow& win, V3 n, V3 v,
                 double tc = e0 * cc[cw];
                 int cx = reference::search_cdf(cc, 0, cw, tc);
                 double rc = std::clamp((tc - cc[cx]) / (cc[cx + 1] - cc[cx]), 0.0, 1.0 - 1e-12);
-                pg = S.dist.sample_in_cell(cy * cw + cx, rc, rr, dw, u, vv);
+                cell = cy * cw + cx;
+                pg = S.dist.sample_in_cell(cell, rc, rr, dw, u, vv);
             }
-            pe = pg > 0 ? win.pdf(S.dist, u, vv, pg) : 0.0;
+            pe = pg > 0 ? win.pdf_in_cell(cell, pg) : 0.0;
         }
         if (pe > 0) {
             V3 lw{dw[0], dw[1], dw[2]};

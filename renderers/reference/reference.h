@@ -170,6 +170,7 @@ class EnvDistribution {
 
   private:
     double place(int i, int j, double du, double dv, double dir[3], double& u, double& v) const;
+    void env_to_world(const double e[3], double d[3]) const;
     int w_ = 0, h_ = 0;
     int cw_ = 0, ch_ = 0;                 // cells
     std::vector<int> cell_i0_, cell_j0_;  // cw_ + 1, ch_ + 1 pixel bounds
