@@ -40,6 +40,6 @@ render grazing studio 8192                   # ~1.5 min: 0.06 %, FLIP 0.0005
 render sphere studio 8192 metallic=1 roughness=0.02   # ~1 min: 0.04 %, FLIP 0.0006 (stability suite)
 render roughness_sweep studio 16384          # ~9 min: 0.18 %, FLIP 0.0017
 render roughness_sweep sky_sun 12288         # ~7.5 min: 0.13 %, FLIP 0.0013
-render roughness_sweep blender:sunrise 32768  # ~32 min: 0.09 %, FLIP 0.0021 (FLIP not met: CONVERGENCE.md)
+render roughness_sweep blender:sunrise 40960  # ~23 min: 0.08 %, FLIP 0.00194 (FLIP sets the count: CONVERGENCE.md)
 render roughness_sweep blender:interior 40960 # ~25 min: 0.21 %, FLIP 0.0023 (FLIP not met: CONVERGENCE.md)
 echo "[goldens] done in $(( $(date +%s) - start )) s -> $OUT"
