@@ -31,8 +31,8 @@ render() { # scene env spp [key=value...]: the file name is harness/golden_store
 }
 # spp per golden and what it reaches (CONVERGENCE.md; the JSON states it in noise_floor.criterion).
 # Issue 5's criterion (FLIP < 0.002, rel. RMSE < 0.5 %) with the windowed estimator: see the comment on
-# each line; the two Blender sweeps miss its FLIP half (their dim pixels, CONVERGENCE.md).
-# Whole script: ~80 min on a 2-core machine (4721 s measured, partly shared; the Blender sweeps ~55 min).
+# each line; all nine meet it. The two Blender sweeps need the most samples (FLIP ∝ N^-0.4 there, CONVERGENCE.md).
+# Whole script: ~100 min on a 2-core machine (the sum of the lines' times; the Blender sweeps ~78 min).
 render furnace constant:1 4096               # ~0.5 min: 0.05 %, FLIP 0.0004
 render furnace_dielectric constant:1 4096    # ~0.5 min: 0.09 %, FLIP 0.0006
 render sphere studio 8192                    # ~1 min: 0.11 %, FLIP 0.0011
@@ -41,5 +41,5 @@ render sphere studio 8192 metallic=1 roughness=0.02   # ~1 min: 0.04 %, FLIP 0.0
 render roughness_sweep studio 16384          # ~9 min: 0.18 %, FLIP 0.0017
 render roughness_sweep sky_sun 12288         # ~7.5 min: 0.13 %, FLIP 0.0013
 render roughness_sweep blender:sunrise 40960  # ~23 min: 0.08 %, FLIP 0.00194 (FLIP sets the count: CONVERGENCE.md)
-render roughness_sweep blender:interior 40960 # ~25 min: 0.21 %, FLIP 0.0023 (FLIP not met: CONVERGENCE.md)
+render roughness_sweep blender:interior 98304 # ~55 min: 0.13 %, FLIP 0.00166 (FLIP sets the count: CONVERGENCE.md)
 echo "[goldens] done in $(( $(date +%s) - start )) s -> $OUT"
