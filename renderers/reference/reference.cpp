@@ -4,9 +4,10 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <cstdio>
 #include <cmath>
 #include <thread>
+
+#include <fmt/format.h>
 
 #include "renderers/material_model.h"
 
@@ -582,15 +583,9 @@ void shade(const Shader& S, const MatConst& M, const EnvWindow& win, V3 n, V3 v,
     }
 }
 
-std::string format_g(double v) {
-    char b[32];
-    std::snprintf(b, sizeof b, "%g", v);
-    return b;
-}
-
 std::string estimator_description(bool window, bool lobe_window, double compensation, int silhouette_boost) {
     std::string env = std::string("environment sampling [piecewise-constant equirect distribution ~ ") +
-                      (compensation > 0 ? "max(0, 3x3-max luminance - " + format_g(compensation) +
+                      (compensation > 0 ? "max(0, 3x3-max luminance - " + fmt::format("{:g}", compensation) +
                                               " x mean luminance) (MIS compensation, Karlik et al. 2019)"
                                         : std::string("3x3-max luminance")) +
                       " * solid angle, guide-table CDF inversion";

@@ -150,7 +150,7 @@ class EnvDistribution {
     void to_uv(const double dir[3], double& u, double& v) const;
     double pdf_uv(double u, double v) const;
 
-    // Coarse cells (at most 64x32, each a block of equirect pixels) for the per-pixel windowed
+    // Coarse cells (at most 128x64, each a block of equirect pixels) for the per-pixel windowed
     // distribution (reference.cpp, EnvWindow): sampling cell c with probability P_c and then a pixel of
     // c from this distribution restricted to c gives the solid-angle pdf  pdf(ω) · P_c / (W_c / total),
     // W_c the cell's mass. The window only rescales whole cells, so pdf() and a per-cell factor give

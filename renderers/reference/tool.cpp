@@ -82,7 +82,7 @@ int main(int argc, char** argv) {
                                    {"what_differs", "the lighting random numbers only: both renders integrate each pixel's "
                                                     "footprint with the same sub-pixel pattern (pixel_pattern), see reference.h"}};
             // Issue 5's convergence criterion, stated with its verdict.
-            const double flip = meta["noise_floor"]["mean_flip"].get<double>();
+            const double flip = fr.mean;
             meta["noise_floor"]["criterion"] = {{"mean_flip_below", 0.002},
                                                 {"relative_rmse_below", 0.005},
                                                 {"mean_flip_met", flip < 0.002},
