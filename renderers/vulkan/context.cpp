@@ -4,6 +4,7 @@
 #include <regex>
 
 #include "harness/common/errors.h"
+#include "spirv_cost.h"
 
 namespace iblcheck::vk {
 
@@ -217,6 +218,7 @@ Context::Context(const ContextOptions& options) {
         vkGetPhysicalDeviceFeatures2(physical_, &f2);
         info_.shader_float16 = f12.shaderFloat16;
         info_.storage_16bit = f11.storageBuffer16BitAccess;
+        info_.int64_atomics = f2.features.shaderInt64 && f12.shaderBufferInt64Atomics;
 
         VkPhysicalDeviceVulkan11Features e11{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_FEATURES};
         VkPhysicalDeviceVulkan12Features e12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
@@ -228,6 +230,8 @@ Context::Context(const ContextOptions& options) {
         e2.pNext = &e11;
         e2.features.shaderInt16 = f2.features.shaderInt16;
         e2.features.shaderFloat64 = f2.features.shaderFloat64;
+        e2.features.shaderInt64 = f2.features.shaderInt64;                  // instruction counting
+        e12.shaderBufferInt64Atomics = f12.shaderBufferInt64Atomics;
 
         float prio = 1.0f;
         VkDeviceQueueCreateInfo qci{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
@@ -543,6 +547,10 @@ ComputePipeline::ComputePipeline(Context& ctx, const CompiledShader& shader,
     std::vector<VkDescriptorSetLayoutBinding> lb;
     for (uint32_t i = 0; i < bindings.size(); ++i)
         lb.push_back({i, bindings[i], 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr});
+    if (shader.counts_instructions && bindings.size() > kCostBinding)
+        throw Error("ComputePipeline: binding " + std::to_string(kCostBinding) + " is the instruction counter's");
+    if (shader.counts_instructions)
+        lb.push_back({kCostBinding, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr});
     VkDescriptorSetLayoutCreateInfo dl{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
     dl.flags = VK_DESCRIPTOR_SET_LAYOUT_CREATE_PUSH_DESCRIPTOR_BIT_KHR;
     dl.bindingCount = uint32_t(lb.size());

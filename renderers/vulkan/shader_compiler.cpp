@@ -14,6 +14,7 @@
 
 #include "harness/common/errors.h"
 #include "harness/common/hash.h"
+#include "spirv_cost.h"
 
 namespace fs = std::filesystem;
 
@@ -131,13 +132,13 @@ std::string shader_tree_hash() {
     return h.hex();
 }
 
-CompiledShader compile_compute_shader(const std::string& name, const Defines& defines) {
+CompiledShader compile_compute_shader(const std::string& name, const Defines& defines, bool count_instructions) {
     fs::path p = shader_dir() / name;
     if (!fs::exists(p)) throw ShaderCompileError(p.string() + ": shader source not found");
-    return compile_compute_shader_file(p, defines);
+    return compile_compute_shader_file(p, defines, count_instructions);
 }
 
-CompiledShader compile_compute_shader_file(const fs::path& path_in, const Defines& defines) {
+CompiledShader compile_compute_shader_file(const fs::path& path_in, const Defines& defines, bool count_instructions) {
     fs::path path = fs::weakly_canonical(path_in);
     Fnv1a64 h;
     h.update("comp;glslang-vulkan1.2;");
@@ -148,8 +149,10 @@ CompiledShader compile_compute_shader_file(const fs::path& path_in, const Define
         preamble += "#define " + k + " " + v + "\n";
         h.update(k + "=" + v + ";");
     }
+    if (count_instructions) h.update("count_instructions=" + std::to_string(kCostPassVersion) + ";");
     CompiledShader out;
     out.source_hash = h.hex();
+    out.counts_instructions = count_instructions;
 
     fs::path cached = spirv_cache_dir() / (out.source_hash + ".spv");
     if (std::ifstream f{cached, std::ios::binary}) {
@@ -189,6 +192,8 @@ CompiledShader compile_compute_shader_file(const fs::path& path_in, const Define
         opt.disableOptimizer = true;  // lavapipe's LLVM optimises; keep SPIR-V faithful to the source
         glslang::GlslangToSpv(*program.getIntermediate(EShLangCompute), out.spirv, &opt);
     }
+    // Last, so that it counts exactly the instructions the pipeline will execute.
+    if (count_instructions) out.spirv = instrument_instruction_count(out.spirv);
 
     std::error_code ec;
     fs::create_directories(spirv_cache_dir(), ec);

@@ -21,6 +21,7 @@ struct CompiledShader {
     std::vector<uint32_t> spirv;
     std::string source_hash; // hash of the sources + defines: the key of the cache, for provenance
     bool from_cache = false;
+    bool counts_instructions = false; // instrumented by spirv_cost.h: binds the counter at kCostBinding
 };
 
 // The folder shaders are read from: $IBLCHECK_SHADER_DIR or <source root>/renderers/shaders.
@@ -28,10 +29,13 @@ std::filesystem::path shader_dir();
 
 // Compiles the compute shader `name` (a file under shader_dir(), e.g. "prefilter_ggx.comp").
 // Throws ShaderCompileError whose message starts "file:line: " for every error glslang reports.
-CompiledShader compile_compute_shader(const std::string& name, const Defines& defines = {});
+// count_instructions: the SPIR-V counts the instructions it executes (spirv_cost.h); part of the key.
+CompiledShader compile_compute_shader(const std::string& name, const Defines& defines = {},
+                                      bool count_instructions = false);
 
 // Same, for a full path (tests compile shaders from temporary folders).
-CompiledShader compile_compute_shader_file(const std::filesystem::path& path, const Defines& defines = {});
+CompiledShader compile_compute_shader_file(const std::filesystem::path& path, const Defines& defines = {},
+                                           bool count_instructions = false);
 
 // A hash over every .glsl/.comp file in shader_dir(): the "shader source hash" of provenance.
 std::string shader_tree_hash();
