@@ -5,6 +5,8 @@
 
 #include <cmath>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 
 #include "renderers/environments/environment.h"
 #include "renderers/mobile/gpu_session.h"
@@ -269,4 +271,130 @@ TEST(MobileOptions, UnknownOptionAndValueAreUsageErrors) {
     EXPECT_THROW(validate_spec(spec("sphere", "studio", {{"no_such_option", "1"}})), UsageError);
     EXPECT_THROW(render(spec("sphere", "studio", {{"mip_mapping", "bogus"}})), UsageError);
     EXPECT_THROW(render(spec("sphere", "studio", {{"cube_size", "100"}})), UsageError);
+}
+
+// --- The deterministic cost (issue 14): SPIR-V instructions per pixel --------------------------
+
+namespace {
+
+RenderResult render_in(GpuSession& gpu, const TestSpec& s) {
+    validate_spec(s);
+    Environment env = load_environment(s.env);
+    return s.method == "sampled" ? render_sampled(gpu, env, s) : render_mobile(gpu, env, s);
+}
+
+std::string read_text(const std::filesystem::path& p) {
+    std::ifstream in(p);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+bool identical(const cv::Mat& a, const cv::Mat& b) {
+    return a.size() == b.size() && std::memcmp(a.data, b.data, a.total() * a.elemSize()) == 0;
+}
+
+} // namespace
+
+TEST(MobileCost, CountIsIdenticalOverRendersAndSessions) {
+    // Measured: roughness_sweep under sky_sun, 10 renders in one session: 6275.923611111111
+    // SPIR-V instructions per pixel every time (spread 0); another GpuSession, the same.
+    TestSpec s = spec("roughness_sweep", "sky_sun");
+    RenderResult first = render(s);
+    EXPECT_EQ(first.provenance["cost"]["spirv_instructions_per_pixel"].get<double>(), first.shader_instructions_per_pixel);
+    EXPECT_EQ(first.provenance["cost"]["texture_fetches_per_pixel"].get<double>(), first.texture_fetches_per_pixel);
+    // Four rays a pixel (ssaa 2) of ~1.5e3 instructions where a sphere is hit.
+    EXPECT_GT(first.shader_instructions_per_pixel, 1000.0);
+    EXPECT_LT(first.shader_instructions_per_pixel, 20000.0);
+    // The count is an integer total over the image's pixels.
+    double total = first.shader_instructions_per_pixel * first.image.cols * first.image.rows;
+    EXPECT_NEAR(total, std::round(total), 1e-3);
+    double lo = first.shader_instructions_per_pixel, hi = lo;
+    for (int i = 1; i < 10; ++i) {
+        double c = render(s).shader_instructions_per_pixel;
+        lo = std::min(lo, c);
+        hi = std::max(hi, c);
+    }
+    EXPECT_EQ(hi - lo, 0.0);
+    {
+        GpuSession other(vk::ContextOptions{"", true});
+        EXPECT_EQ(render_in(other, s).shader_instructions_per_pixel, first.shader_instructions_per_pixel);
+    }
+    // The environment does not steer the shader's branches: studio counts the same.
+    EXPECT_EQ(render(spec("roughness_sweep", "studio")).shader_instructions_per_pixel, first.shader_instructions_per_pixel);
+    // A variant counts its own code: the LUT's fetch and uv take fewer instructions than
+    // EnvBRDFApprox's polynomial (measured 6269.75 a pixel).
+    EXPECT_LT(render(spec("roughness_sweep", "sky_sun", {{"env_brdf", "lut"}})).shader_instructions_per_pixel,
+              first.shader_instructions_per_pixel);
+
+    // The sampled peer: 64 samples a ray.
+    TestSpec sampled = spec("roughness_sweep", "sky_sun", {{"samples", "64"}});
+    sampled.method = "sampled";
+    RenderResult a = render_in(session(), sampled), b = render_in(session(), sampled);
+    EXPECT_GT(a.shader_instructions_per_pixel, 5 * first.shader_instructions_per_pixel);
+    EXPECT_EQ(a.shader_instructions_per_pixel, b.shader_instructions_per_pixel);
+    EXPECT_EQ(a.provenance["cost"]["spirv_instructions_per_pixel"].get<double>(), a.shader_instructions_per_pixel);
+    expect_no_validation_errors();
+}
+
+TEST(MobileCost, ShadingTwiceDoublesTheCountAndARunawayLoopMultipliesIt) {
+    // Issue 14: both changes leave every pixel bit-identical, so only the cost can see them.
+    namespace fs = std::filesystem;
+    fs::path dir = fs::temp_directory_path() / ("iblcheck_test_cost_" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    fs::copy(fs::path(IBLCHECK_SOURCE_DIR) / "renderers/shaders", dir / "shaders", fs::copy_options::recursive);
+    const fs::path file = dir / "shaders/shade_spheres.comp";
+    const std::string original = read_text(file);
+    auto edited = [&](const std::string& from, const std::string& to) {
+        std::string text = original;
+        size_t at = text.find(from);
+        EXPECT_NE(at, std::string::npos) << from;
+        if (at != std::string::npos) text.replace(at, from.size(), to);
+        std::ofstream(file) << text;
+    };
+    TestSpec s = spec("roughness_sweep", "sky_sun");
+    TestSpec small = s;  // the runaway loop's image: small, to keep the test quick
+    small.width = 128;
+    small.height = 64;
+    RenderResult base = render(s), base_small = render(small);
+
+    auto render_modified = [&](const TestSpec& t) {
+        setenv("IBLCHECK_SHADER_DIR", (dir / "shaders").c_str(), 1);
+        RenderResult r;
+        try {
+            GpuSession gpu(vk::ContextOptions{"", true});  // a fresh pipeline cache
+            r = render_in(gpu, t);
+            EXPECT_EQ(gpu.ctx().validation_errors(), 0);
+        } catch (...) {
+            unsetenv("IBLCHECK_SHADER_DIR");
+            throw;
+        }
+        unsetenv("IBLCHECK_SHADER_DIR");
+        return r;
+    };
+
+    // Every ray shaded twice and averaged: 0.5 * (a + a) == a exactly.
+    edited("for (uint i = 0u; i < n; ++i) sum += shade_ray(vec2(px) + (vec2(i, j) + 0.5) / float(n));",
+           "for (uint i = 0u; i < n; ++i) {\n"
+           "            vec2 p = vec2(px) + (vec2(i, j) + 0.5) / float(n);\n"
+           "            sum += 0.5 * (shade_ray(p) + shade_ray(p));\n"
+           "        }");
+    RenderResult twice = render_modified(s);
+    EXPECT_TRUE(identical(twice.image, base.image));
+    double factor = twice.shader_instructions_per_pixel / base.shader_instructions_per_pixel;
+    RecordProperty("twice_factor", std::to_string(factor));
+    EXPECT_GE(factor, 1.9) << twice.shader_instructions_per_pixel << " vs " << base.shader_instructions_per_pixel;
+    EXPECT_LT(factor, 2.0);  // the per-pixel loop and the store are not doubled
+
+    // A runaway loop in shade_ray whose result is multiplied by 0 (what issue 14 saw pass).
+    edited("    return vec4(vec3(diffuse + specular), 1.0);\n}",
+           "    float waste = 0.0;\n"
+           "    for (uint k = 0u; k < 2500u; ++k) waste += sin(float(k) * roughness);\n"
+           "    return vec4(vec3(diffuse + specular), 1.0) + vec4(0.0) * waste;\n}");
+    RenderResult runaway = render_modified(small);
+    EXPECT_TRUE(identical(runaway.image, base_small.image));
+    double runaway_factor = runaway.shader_instructions_per_pixel / base_small.shader_instructions_per_pixel;
+    RecordProperty("runaway_factor", std::to_string(runaway_factor));
+    EXPECT_GT(runaway_factor, 10.0) << runaway.shader_instructions_per_pixel << " vs "
+                                    << base_small.shader_instructions_per_pixel;
+    fs::remove_all(dir);
 }

@@ -6,6 +6,7 @@
 #include "harness/common/errors.h"
 #include "ibl_precompute.h"
 #include "renderers/scenes/scene.h"
+#include "shading_cost.h"
 
 namespace iblcheck {
 
@@ -60,8 +61,8 @@ RenderResult render_mobile(GpuSession& gpu, const Environment& env, const TestSp
     defs["NORMALIZATION"] = index_of("normalization", normalization, {"off", "ue4"});
     defs["PRECISION_MEDIUMP"] = precision == "mediump" ? "1" : "0";
     defs["SPECULAR_AA"] = index_of("specular_aa", spec_aa, {"off", "tokuyoshi", "rjump", "toksvig"});
-    const auto& shade = gpu.pipeline("shade_spheres.comp", defs,
-                                     {kStorageBuffer, kSampled, kStorageBuffer, kSampled, kSampled, kStorageBuffer}, 48);
+    const std::vector<VkDescriptorType> types = {kStorageBuffer, kSampled, kStorageBuffer, kSampled, kSampled, kStorageBuffer};
+    const auto& shade = gpu.pipeline("shade_spheres.comp", defs, types, 48);
 
     vk::Context& ctx = gpu.ctx();
     vk::Buffer scene_buf = upload_scene(ctx, scene);
@@ -85,15 +86,15 @@ RenderResult render_mobile(GpuSession& gpu, const Environment& env, const TestSp
     if (pc.ssaa < 1 || pc.ssaa > 16) throw UsageError("option 'ssaa' must be in 1..16");
     if (pc.mix_end <= pc.mix_begin) throw UsageError("option 'mix_end_roughness' must exceed 'mix_begin_roughness'");
 
+    std::vector<vk::Binding> b = {vk::Binding::storage_buffer(0, scene_buf),
+                                  vk::Binding::sampled_image(1, ibl.prefiltered.sampled_view, ctx.linear_sampler()),
+                                  vk::Binding::storage_buffer(2, ibl.sh),
+                                  vk::Binding::sampled_image(3, ibl.lut.sampled_view, ctx.linear_sampler()),
+                                  vk::Binding::sampled_image(4, ibl.irradiance.sampled_view, ctx.linear_sampler()),
+                                  vk::Binding::storage_buffer(5, out)};
     vk::GpuTimer timer(ctx, 1);
     ctx.submit([&](VkCommandBuffer cmd) {
         timer.reset(cmd);
-        std::vector<vk::Binding> b = {vk::Binding::storage_buffer(0, scene_buf),
-                                      vk::Binding::sampled_image(1, ibl.prefiltered.sampled_view, ctx.linear_sampler()),
-                                      vk::Binding::storage_buffer(2, ibl.sh),
-                                      vk::Binding::sampled_image(3, ibl.lut.sampled_view, ctx.linear_sampler()),
-                                      vk::Binding::sampled_image(4, ibl.irradiance.sampled_view, ctx.linear_sampler()),
-                                      vk::Binding::storage_buffer(5, out)};
         shade.warm_up(cmd, b, &pc, sizeof pc);
         timer.begin(cmd, "shade_spheres");
         shade.dispatch(cmd, b, &pc, sizeof pc, (width + 7) / 8, (height + 7) / 8, 1);
@@ -106,7 +107,10 @@ RenderResult render_mobile(GpuSession& gpu, const Environment& env, const TestSp
     // irradiance cube when used (SH9 is arithmetic).
     double per_hit = 1.0 + (ps.lut ? 1.0 : 0.0) + (ps.irradiance_cube ? 1.0 : 0.0);
     result.texture_fetches_per_pixel = coverage * pc.ssaa * pc.ssaa * per_hit;
+    auto instructions = shading_instructions_per_pixel(gpu, {"shade_spheres.comp", defs, types, b, 5, &pc, sizeof pc, width, height}, out);
+    result.shader_instructions_per_pixel = instructions.value_or(0);
     result.provenance = {{"method", "mobile"},
+                         {"cost", cost_provenance(instructions, result.texture_fetches_per_pixel)},
                          {"precompute_cached", cached},
                          {"cube_size", ps.cube_size},
                          {"mips", std::min(ps.mips, ibl.full_mips)},
