@@ -3,6 +3,9 @@
 // determinism. Validation layers are on: any validation error fails the test.
 #include <gtest/gtest.h>
 
+#include <sys/wait.h>
+
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -288,6 +291,16 @@ std::string read_text(const std::filesystem::path& p) {
     return std::string(std::istreambuf_iterator<char>(in), {});
 }
 
+// Runs a shell command; returns its exit status and stdout.
+int run_command(const std::string& cmd, std::string& out) {
+    FILE* pipe = popen(cmd.c_str(), "r");
+    std::array<char, 4096> buf;
+    out.clear();
+    while (fgets(buf.data(), buf.size(), pipe)) out += buf.data();
+    int status = pclose(pipe);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
 bool identical(const cv::Mat& a, const cv::Mat& b) {
     return a.size() == b.size() && std::memcmp(a.data, b.data, a.total() * a.elemSize()) == 0;
 }
@@ -333,6 +346,32 @@ TEST(MobileCost, CountIsIdenticalOverRendersAndSessions) {
     EXPECT_EQ(a.shader_instructions_per_pixel, b.shader_instructions_per_pixel);
     EXPECT_EQ(a.provenance["cost"]["spirv_instructions_per_pixel"].get<double>(), a.shader_instructions_per_pixel);
     expect_no_validation_errors();
+}
+
+TEST(MobileCost, CountIsIdenticalOnAnotherCpuClassAndOneThread) {
+    // The count is of SPIR-V, not machine code: lavapipe limited to SSE4.1 (128-bit vectors instead
+    // of 256, no FMA), or to one thread, in a child process, gives the very same figure for the
+    // mobile pass and for the sampled one (whose sample loop skips samples by sign tests).
+    TestSpec mobile = spec("roughness_sweep", "sky_sun"), sampled = spec("roughness_sweep", "sky_sun", {{"samples", "64"}});
+    sampled.method = "sampled";
+    for (const TestSpec* s : {&mobile, &sampled}) {
+        double here = render_in(session(), *s).shader_instructions_per_pixel;
+        for (std::string env : {"GALLIUM_OVERRIDE_CPU_CAPS=sse4.1", "LP_NUM_THREADS=1"}) {
+            std::string out;
+            int rc = run_command(env + " " + std::string(IBLCHECK_BINARY_DIR) + "/iblcheck render --scene roughness_sweep --method " +
+                                     s->method + " --env sky_sun" + (s == &sampled ? " --set samples=64" : "") +
+                                     " --json - 2>/dev/null",
+                                 out);
+            ASSERT_EQ(rc, 0) << env << ": " << out;
+            nlohmann::json j = nlohmann::json::parse(out);
+            EXPECT_EQ(j["shader_instructions_per_pixel"].get<double>(), here) << s->method << ", " << env;
+            EXPECT_EQ(j["provenance"]["cost"]["spirv_instructions_per_pixel"].get<double>(), here) << s->method << ", " << env;
+            if (env.find("sse4.1") != std::string::npos) {
+                EXPECT_NE(j["provenance"]["driver"]["device"].get<std::string>().find("128 bits"), std::string::npos)
+                    << "the override did not reach lavapipe: " << j["provenance"]["driver"];
+            }
+        }
+    }
 }
 
 TEST(MobileCost, ShadingTwiceDoublesTheCountAndARunawayLoopMultipliesIt) {
