@@ -152,7 +152,7 @@ TEST(SpirvCost, LoopCountGrowsExactlyLinearlyWithTheBodysStaticCount) {
     const uint64_t slope = b[1] + b[2] + b[3] + b[4];  // one more trip: header + condition + body + continue
     const uint64_t base = b[0] + b[1] + b[2] + b[5];   // no trip: entry, the failing test, merge
     EXPECT_EQ(slope, 19u);  // this glslang's output: 2 + 6 + 7 + 4 (the disassembly, by hand)
-    EXPECT_EQ(base, 22u);   // 6 + 2 + 6 + 8
+    EXPECT_EQ(base, 22u);   // 9 + 2 + 6 + 5
 
     std::vector<uint32_t> data(128, 0);
     auto counted = instrument_checked(s, data, 0);
