@@ -4,6 +4,7 @@
 #include "commands.h"
 #include "harness/common/errors.h"
 #include "renderers/vulkan/context.h"
+#include "renderers/vulkan/cpu_caps.h"
 
 namespace iblcheck::cli {
 
@@ -30,6 +31,15 @@ void register_doctor_command(CLI::App& app, int& exit_code) {
         fmt::print("timestamps:      {} (period {} ns)\n", i.timestamps ? "yes" : "no", i.timestamp_period_ns);
         fmt::print("validation:      {}\n", i.validation ? "on" : "off");
         fmt::print("shader folder:   {}\n", vk::shader_dir().string());
+        // What llvmpipe generates shader code for (lavapipe compiles for the host CPU); meaningful
+        // when the driver is llvmpipe.
+        LlvmpipeCaps caps = llvmpipe_caps();
+        auto yn = [](bool b) { return b ? "yes" : "no"; };
+        fmt::print("llvmpipe cpu:    {} (vector width {} bits; F16C {}, FMA {}, AVX2 {}, AVX-512 {})\n", caps.cpu_class(),
+                   caps.vector_width, yn(caps.f16c), yn(caps.fma), yn(caps.avx2), yn(caps.avx512));
+        if (!caps.override_caps.empty())
+            fmt::print("cpu override:    GALLIUM_OVERRIDE_CPU_CAPS={}\n", caps.override_caps);
+        if (!caps.warning.empty()) fmt::print(stderr, "warning: {}\n", caps.warning);
         fmt::print("all devices:\n");
         for (const auto& d : i.available_devices) fmt::print("  {}\n", d);
         exit_code = i.timestamps ? kExitPass : kExitError;
