@@ -12,6 +12,8 @@
 #include <set>
 #include <sstream>
 
+#include "fp16_emulation.h"
+#include "fp16_pass_hash.h"  // generated: IBLCHECK_FP16_PASS_HASH
 #include "harness/common/errors.h"
 #include "harness/common/hash.h"
 
@@ -131,13 +133,14 @@ std::string shader_tree_hash() {
     return h.hex();
 }
 
-CompiledShader compile_compute_shader(const std::string& name, const Defines& defines) {
+CompiledShader compile_compute_shader(const std::string& name, const Defines& defines, const CompileOptions& options) {
     fs::path p = shader_dir() / name;
     if (!fs::exists(p)) throw ShaderCompileError(p.string() + ": shader source not found");
-    return compile_compute_shader_file(p, defines);
+    return compile_compute_shader_file(p, defines, options);
 }
 
-CompiledShader compile_compute_shader_file(const fs::path& path_in, const Defines& defines) {
+CompiledShader compile_compute_shader_file(const fs::path& path_in, const Defines& defines,
+                                           const CompileOptions& options) {
     fs::path path = fs::weakly_canonical(path_in);
     Fnv1a64 h;
     h.update("comp;glslang-vulkan1.2;");
@@ -148,6 +151,7 @@ CompiledShader compile_compute_shader_file(const fs::path& path_in, const Define
         preamble += "#define " + k + " " + v + "\n";
         h.update(k + "=" + v + ";");
     }
+    if (options.emulate_fp16) h.update("pass:fp16-emulation:" IBLCHECK_FP16_PASS_HASH ";");
     CompiledShader out;
     out.source_hash = h.hex();
 
@@ -188,6 +192,13 @@ CompiledShader compile_compute_shader_file(const fs::path& path_in, const Define
         glslang::SpvOptions opt;
         opt.disableOptimizer = true;  // lavapipe's LLVM optimises; keep SPIR-V faithful to the source
         glslang::GlslangToSpv(*program.getIntermediate(EShLangCompute), out.spirv, &opt);
+    }
+    if (options.emulate_fp16) {
+        try {
+            emulate_fp16(out.spirv);
+        } catch (const ShaderCompileError& e) {
+            throw ShaderCompileError(path.string() + ": " + e.what());
+        }
     }
 
     std::error_code ec;
