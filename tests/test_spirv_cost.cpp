@@ -19,6 +19,12 @@ namespace fs = std::filesystem;
 using namespace iblcheck;
 
 namespace {
+// Compile options that instrument the shader (spirv_cost.h).
+const vk::CompileOptions kCounted = [] {
+    vk::CompileOptions o;
+    o.count_instructions = true;
+    return o;
+}();
 
 fs::path temp_dir() {
     static fs::path p = [] {
@@ -296,12 +302,12 @@ TEST(SpirvCost, InstrumentedShaderIsCachedUnderItsOwnKey) {
     fs::path p = temp_dir() / "keyed.comp";
     std::ofstream(p) << kLoop;
     auto plain = vk::compile_compute_shader_file(p);
-    auto counted = vk::compile_compute_shader_file(p, {}, true);
+    auto counted = vk::compile_compute_shader_file(p, {}, kCounted);
     EXPECT_NE(plain.source_hash, counted.source_hash);
     EXPECT_FALSE(plain.counts_instructions);
     EXPECT_TRUE(counted.counts_instructions);
     EXPECT_EQ(counted.spirv, vk::instrument_instruction_count(plain.spirv));
-    auto again = vk::compile_compute_shader_file(p, {}, true);
+    auto again = vk::compile_compute_shader_file(p, {}, kCounted);
     EXPECT_TRUE(again.from_cache);
     EXPECT_TRUE(again.counts_instructions);
     EXPECT_EQ(again.spirv, counted.spirv);

@@ -12,6 +12,7 @@
 
 #include "harness/common/errors.h"
 #include "renderers/vulkan/context.h"
+#include "renderers/vulkan/fp16_emulation.h"
 
 namespace fs = std::filesystem;
 using namespace iblcheck;
@@ -160,6 +161,28 @@ TEST(Doctor, NamesLlvmpipeAndExitsZero) {
     EXPECT_EQ(rc, 0) << out;
     EXPECT_NE(out.find("llvmpipe"), std::string::npos) << out;
     EXPECT_NE(out.find("shaderFloat16:   yes"), std::string::npos) << out;
+}
+
+TEST(Doctor, StatesTheFp16DecisionTheRendererMakes) {
+    // The line comes from choose_fp16_path, the renderer's rule: native here, emulated when
+    // llvmpipe targets a CPU without AVX (no F16C, no shaderFloat16). Before issue 15 doctor
+    // claimed an fp32 fallback while the renderer refused the variant.
+    vk::Context ctx({"", false});
+    std::string expected = "precision=mediump: " + vk::fp16_path_description(vk::choose_fp16_path(
+                                                       "auto", ctx.info().shader_float16, ctx.info().device_name));
+    std::string out;
+    EXPECT_EQ(run_command(std::string(IBLCHECK_BINARY_DIR) + "/iblcheck doctor", out), 0) << out;
+    EXPECT_NE(out.find(expected + "\n"), std::string::npos) << out;
+    EXPECT_NE(out.find("precision=mediump: native float16_t\n"), std::string::npos) << out;
+    EXPECT_NE(out.find("llvmpipe cpu:    "), std::string::npos) << out;
+    EXPECT_EQ(run_command("GALLIUM_OVERRIDE_CPU_CAPS=sse4.1 " + std::string(IBLCHECK_BINARY_DIR) + "/iblcheck doctor", out),
+              0)
+        << out;
+    EXPECT_NE(out.find("shaderFloat16:   no\n"), std::string::npos) << out;
+    EXPECT_NE(out.find("precision=mediump: " + vk::fp16_path_description(vk::Fp16Path::emulated) + "\n"),
+              std::string::npos)
+        << out;
+    EXPECT_NE(out.find("cpu override:    GALLIUM_OVERRIDE_CPU_CAPS=sse4.1"), std::string::npos) << out;
 }
 
 TEST(Doctor, WithoutDriverExitsTwoWithAFix) {

@@ -4,6 +4,8 @@
 #include "commands.h"
 #include "harness/common/errors.h"
 #include "renderers/vulkan/context.h"
+#include "renderers/vulkan/cpu_caps.h"
+#include "renderers/vulkan/fp16_emulation.h"
 
 namespace iblcheck::cli {
 
@@ -25,11 +27,23 @@ void register_doctor_command(CLI::App& app, int& exit_code) {
         fmt::print("mesa version:    {}\n", i.mesa_version.empty() ? "n/a" : i.mesa_version);
         fmt::print("llvm version:    {}\n", i.llvm_version.empty() ? "n/a" : i.llvm_version);
         fmt::print("vulkan api:      {}\n", i.api_version);
-        fmt::print("shaderFloat16:   {}\n", i.shader_float16 ? "yes" : "no (precision=mediump falls back to fp32)");
+        fmt::print("shaderFloat16:   {}\n", i.shader_float16 ? "yes" : "no");
+        // The renderer's own rule (fp16=auto), so this line cannot disagree with what a render does.
+        fmt::print("precision=mediump: {}\n",
+                   vk::fp16_path_description(vk::choose_fp16_path("auto", i.shader_float16, i.device_name)));
         fmt::print("16-bit storage:  {}\n", i.storage_16bit ? "yes" : "no");
         fmt::print("timestamps:      {} (period {} ns)\n", i.timestamps ? "yes" : "no", i.timestamp_period_ns);
         fmt::print("validation:      {}\n", i.validation ? "on" : "off");
         fmt::print("shader folder:   {}\n", vk::shader_dir().string());
+        // What llvmpipe generates shader code for (lavapipe compiles for the host CPU); meaningful
+        // when the driver is llvmpipe.
+        LlvmpipeCaps caps = llvmpipe_caps();
+        auto yn = [](bool b) { return b ? "yes" : "no"; };
+        fmt::print("llvmpipe cpu:    {} (vector width {} bits; F16C {}, FMA {}, AVX2 {}, AVX-512 {})\n", caps.cpu_class(),
+                   caps.vector_width, yn(caps.f16c), yn(caps.fma), yn(caps.avx2), yn(caps.avx512));
+        if (!caps.override_caps.empty())
+            fmt::print("cpu override:    GALLIUM_OVERRIDE_CPU_CAPS={}\n", caps.override_caps);
+        if (!caps.warning.empty()) fmt::print(stderr, "warning: {}\n", caps.warning);
         fmt::print("all devices:\n");
         for (const auto& d : i.available_devices) fmt::print("  {}\n", d);
         exit_code = i.timestamps ? kExitPass : kExitError;

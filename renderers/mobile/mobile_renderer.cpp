@@ -1,12 +1,14 @@
 #include "mobile_renderer.h"
 
 #include <chrono>
+#include <optional>
 
 #include "gpu_scene.h"
 #include "harness/common/errors.h"
 #include "ibl_precompute.h"
 #include "renderers/scenes/scene.h"
 #include "shading_cost.h"
+#include "renderers/vulkan/fp16_emulation.h"
 
 namespace iblcheck {
 
@@ -45,8 +47,14 @@ RenderResult render_mobile(GpuSession& gpu, const Environment& env, const TestSp
     std::string spec_aa = o.get_choice("specular_aa", "off", {"off", "tokuyoshi", "rjump", "toksvig"});
     if (ps.prefilter_samples < 1 || ps.prefilter_samples > 65536)
         throw UsageError("option 'prefilter_samples' must be in 1..65536");
-    if (precision == "mediump" && !gpu.ctx().info().shader_float16)
-        throw EnvironmentError(gpu.ctx().info().device_name + ": precision=mediump needs shaderFloat16");
+    std::string fp16 = o.get_choice("fp16", "auto", {"auto", "native", "emulated"});
+    // precision=mediump computes in float16_t: natively, or emulated where the device lacks
+    // shaderFloat16 (or fp16=emulated asks for it). One rule, shared with `iblcheck doctor`.
+    std::optional<vk::Fp16Path> fp16_path;
+    if (precision == "mediump")
+        fp16_path = vk::choose_fp16_path(fp16, gpu.ctx().info().shader_float16, gpu.ctx().info().device_name);
+    vk::CompileOptions shade_options;
+    shade_options.emulate_fp16 = fp16_path == vk::Fp16Path::emulated;
 
     RenderResult result;
     bool cached = false;
@@ -62,7 +70,7 @@ RenderResult render_mobile(GpuSession& gpu, const Environment& env, const TestSp
     defs["PRECISION_MEDIUMP"] = precision == "mediump" ? "1" : "0";
     defs["SPECULAR_AA"] = index_of("specular_aa", spec_aa, {"off", "tokuyoshi", "rjump", "toksvig"});
     const std::vector<VkDescriptorType> types = {kStorageBuffer, kSampled, kStorageBuffer, kSampled, kSampled, kStorageBuffer};
-    const auto& shade = gpu.pipeline("shade_spheres.comp", defs, types, 48);
+    const auto& shade = gpu.pipeline("shade_spheres.comp", defs, types, 48, shade_options);
 
     vk::Context& ctx = gpu.ctx();
     vk::Buffer scene_buf = upload_scene(ctx, scene);
@@ -107,7 +115,7 @@ RenderResult render_mobile(GpuSession& gpu, const Environment& env, const TestSp
     // irradiance cube when used (SH9 is arithmetic).
     double per_hit = 1.0 + (ps.lut ? 1.0 : 0.0) + (ps.irradiance_cube ? 1.0 : 0.0);
     result.texture_fetches_per_pixel = coverage * pc.ssaa * pc.ssaa * per_hit;
-    auto instructions = shading_instructions_per_pixel(gpu, {"shade_spheres.comp", defs, types, b, 5, &pc, sizeof pc, width, height}, out);
+    auto instructions = shading_instructions_per_pixel(gpu, {"shade_spheres.comp", defs, types, shade_options, b, 5, &pc, sizeof pc, width, height}, out);
     result.shader_instructions_per_pixel = instructions.value_or(0);
     result.provenance = {{"method", "mobile"},
                          {"cost", cost_provenance(instructions, result.texture_fetches_per_pixel)},
@@ -116,6 +124,7 @@ RenderResult render_mobile(GpuSession& gpu, const Environment& env, const TestSp
                          {"mips", std::min(ps.mips, ibl.full_mips)},
                          {"storage_native", ps.storage != "r11g11b10" || ibl.native_r11g11b10},
                          {"shader_defines", defs}};
+    if (fp16_path) result.provenance["fp16"] = vk::fp16_path_name(*fp16_path);
     return result;
 }
 

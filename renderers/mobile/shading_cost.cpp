@@ -10,8 +10,9 @@ namespace iblcheck {
 std::optional<double> shading_instructions_per_pixel(GpuSession& gpu, const ShadingPass& pass, const vk::Buffer& out) {
     vk::Context& ctx = gpu.ctx();
     if (!ctx.info().int64_atomics) return std::nullopt;
-    const vk::ComputePipeline& counted =
-        gpu.pipeline(pass.shader, pass.defines, pass.binding_types, pass.push_bytes, true);
+    vk::CompileOptions options = pass.options;
+    options.count_instructions = true;
+    const vk::ComputePipeline& counted = gpu.pipeline(pass.shader, pass.defines, pass.binding_types, pass.push_bytes, options);
     vk::Buffer scratch = ctx.create_buffer(out.size);
     std::vector<vk::Binding> bindings = pass.bindings;
     for (vk::Binding& b : bindings)

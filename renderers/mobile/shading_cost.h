@@ -17,6 +17,7 @@ struct ShadingPass {
     std::string shader;                      // "shade_spheres.comp"
     vk::Defines defines;
     std::vector<VkDescriptorType> binding_types;
+    vk::CompileOptions options;              // as the timed pipeline was compiled (fp16 emulation)
     std::vector<vk::Binding> bindings;
     uint32_t out_binding = 5;                // the vec4 image the pass writes
     const void* push = nullptr;

@@ -56,7 +56,7 @@ RenderResult render_sampled(GpuSession& gpu, const Environment& env, const TestS
     for (auto& [name, ms] : timer.results()) result.timings.push_back({name, ms, true, false});
     double coverage = read_back_image(out, width, height, result.image);
     result.texture_fetches_per_pixel = coverage * pc.ssaa * pc.ssaa * samples;
-    auto instructions = shading_instructions_per_pixel(gpu, {"shade_sampled.comp", {}, types, b, 5, &pc, sizeof pc, width, height}, out);
+    auto instructions = shading_instructions_per_pixel(gpu, {"shade_sampled.comp", {}, types, {}, b, 5, &pc, sizeof pc, width, height}, out);
     result.shader_instructions_per_pixel = instructions.value_or(0);
     result.provenance = {{"method", "sampled"}, {"precompute_cached", cached}, {"samples", samples}, {"cube_size", ps.cube_size},
                          {"seed", pc.seed}, {"cost", cost_provenance(instructions, result.texture_fetches_per_pixel)}};

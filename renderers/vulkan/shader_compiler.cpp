@@ -12,6 +12,8 @@
 #include <set>
 #include <sstream>
 
+#include "fp16_emulation.h"
+#include "fp16_pass_hash.h"  // generated: IBLCHECK_FP16_PASS_HASH
 #include "harness/common/errors.h"
 #include "harness/common/hash.h"
 #include "spirv_cost.h"
@@ -132,13 +134,14 @@ std::string shader_tree_hash() {
     return h.hex();
 }
 
-CompiledShader compile_compute_shader(const std::string& name, const Defines& defines, bool count_instructions) {
+CompiledShader compile_compute_shader(const std::string& name, const Defines& defines, const CompileOptions& options) {
     fs::path p = shader_dir() / name;
     if (!fs::exists(p)) throw ShaderCompileError(p.string() + ": shader source not found");
-    return compile_compute_shader_file(p, defines, count_instructions);
+    return compile_compute_shader_file(p, defines, options);
 }
 
-CompiledShader compile_compute_shader_file(const fs::path& path_in, const Defines& defines, bool count_instructions) {
+CompiledShader compile_compute_shader_file(const fs::path& path_in, const Defines& defines,
+                                           const CompileOptions& options) {
     fs::path path = fs::weakly_canonical(path_in);
     Fnv1a64 h;
     h.update("comp;glslang-vulkan1.2;");
@@ -149,10 +152,11 @@ CompiledShader compile_compute_shader_file(const fs::path& path_in, const Define
         preamble += "#define " + k + " " + v + "\n";
         h.update(k + "=" + v + ";");
     }
-    if (count_instructions) h.update("count_instructions=" + std::to_string(kCostPassVersion) + ";");
+    if (options.count_instructions) h.update("count_instructions=" + std::to_string(kCostPassVersion) + ";");
+    if (options.emulate_fp16) h.update("pass:fp16-emulation:" IBLCHECK_FP16_PASS_HASH ";");
     CompiledShader out;
     out.source_hash = h.hex();
-    out.counts_instructions = count_instructions;
+    out.counts_instructions = options.count_instructions;
 
     fs::path cached = spirv_cache_dir() / (out.source_hash + ".spv");
     if (std::ifstream f{cached, std::ios::binary}) {
@@ -192,8 +196,15 @@ CompiledShader compile_compute_shader_file(const fs::path& path_in, const Define
         opt.disableOptimizer = true;  // lavapipe's LLVM optimises; keep SPIR-V faithful to the source
         glslang::GlslangToSpv(*program.getIntermediate(EShLangCompute), out.spirv, &opt);
     }
+    if (options.emulate_fp16) {
+        try {
+            emulate_fp16(out.spirv);
+        } catch (const ShaderCompileError& e) {
+            throw ShaderCompileError(path.string() + ": " + e.what());
+        }
+    }
     // Last, so that it counts exactly the instructions the pipeline will execute.
-    if (count_instructions) out.spirv = instrument_instruction_count(out.spirv);
+    if (options.count_instructions) out.spirv = instrument_instruction_count(out.spirv);
 
     std::error_code ec;
     fs::create_directories(spirv_cache_dir(), ec);
