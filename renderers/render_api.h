@@ -1,4 +1,4 @@
-// One interface, three methods (DESIGN.md): render(TestSpec) -> RenderResult.
+// One interface, three methods (docs/DESIGN.md): render(TestSpec) -> RenderResult.
 // A renderer knows nothing of metrics; the harness knows nothing of Vulkan.
 #pragma once
 #include <nlohmann/json.hpp>

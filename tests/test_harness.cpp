@@ -134,7 +134,8 @@ TEST(Harness, MissingGoldenThenBlessThenPassThenImproved) {
     EXPECT_EQ(s1.missing, 2);
     EXPECT_EQ(s1.exit_code(), kExitRegression);
     std::string msg = s1.results["tests"][0]["message"];
-    EXPECT_NE(msg.find("iblcheck bless --suite mini --filter 'mobile.furnace.constant:1.default'"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("iblcheck bless --suite '" + o.suite + "' --filter 'mobile.furnace.constant:1.default'"),
+              std::string::npos) << msg;
 
     BlessOptions b;
     b.suite = o.suite;
@@ -144,8 +145,8 @@ TEST(Harness, MissingGoldenThenBlessThenPassThenImproved) {
     ASSERT_TRUE(fs::exists(golden));
     std::ifstream side(fs::path(golden).replace_extension(".json"));
     json prov = json::parse(side);
-    for (const char* key : {"scene", "options", "shader_tree_hash", "driver", "cpu_features", "commit", "date", "command",
-                            "env_hash", "accuracy"})
+    for (const char* key : {"scene", "options", "shader_tree_hash", "driver", "cpu_features", "cpu_class", "commit", "date",
+                            "command", "env_hash", "accuracy", "cost"})
         EXPECT_TRUE(prov.contains(key)) << key;
     EXPECT_EQ(prov["driver"]["driver"], "llvmpipe");
     EXPECT_TRUE(prov["accuracy"].contains("flip.mean"));

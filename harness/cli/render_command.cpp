@@ -101,6 +101,20 @@ void register_render_command(CLI::App& app, int& exit_code) {
                 f << j.dump(2) << "\n";
             }
         }
+        // Non-finite pixels are the shader's fault: a regression (exit 1), after the files are
+        // written so the pixels can be inspected.
+        if (NonFinite nf = find_non_finite(r.image); nf.count) {
+            fmt::print(stderr, "error: {} {} under {}: the render has {}\n", method, scene, env, nf.describe());
+            exit_code = kExitRegression;
+            return;
+        }
+        // Non-finite pixels are the shader's fault: a regression (exit 1), after the files are
+        // written so the pixels can be inspected.
+        if (NonFinite nf = find_non_finite(r.image); nf.count) {
+            fmt::print(stderr, "error: {} {} under {}: the render has {}\n", method, scene, env, nf.describe());
+            exit_code = kExitRegression;
+            return;
+        }
         exit_code = kExitPass;
     });
 }

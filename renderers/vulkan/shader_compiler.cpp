@@ -196,6 +196,11 @@ CompiledShader compile_compute_shader_file(const fs::path& path_in, const Define
         opt.disableOptimizer = true;  // lavapipe's LLVM optimises; keep SPIR-V faithful to the source
         glslang::GlslangToSpv(*program.getIntermediate(EShLangCompute), out.spirv, &opt);
     }
+    // The count comes before the fp16 emulation: it measures the shader as written (what a device
+    // with native fp16 executes), so the cost a baseline records is the same on every CPU class.
+    // The emulation only rewrites 16-bit float instructions and adds no blocks, so the counter's
+    // per-block increments (64-bit integers) pass through it unchanged.
+    if (options.count_instructions) out.spirv = instrument_instruction_count(out.spirv);
     if (options.emulate_fp16) {
         try {
             emulate_fp16(out.spirv);
@@ -203,8 +208,6 @@ CompiledShader compile_compute_shader_file(const fs::path& path_in, const Define
             throw ShaderCompileError(path.string() + ": " + e.what());
         }
     }
-    // Last, so that it counts exactly the instructions the pipeline will execute.
-    if (options.count_instructions) out.spirv = instrument_instruction_count(out.spirv);
 
     std::error_code ec;
     fs::create_directories(spirv_cache_dir(), ec);

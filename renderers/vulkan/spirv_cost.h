@@ -21,7 +21,7 @@ namespace iblcheck::vk {
 // Descriptor set 0 binding of the counter buffer (a single uint64): the shaders use 0..5.
 inline constexpr uint32_t kCostBinding = 15;
 // Part of the SPIR-V cache key of instrumented shaders: bump it when the pass's output changes.
-inline constexpr int kCostPassVersion = 1;
+inline constexpr int kCostPassVersion = 2;  // 2: counted before the fp16 emulation
 
 // A block's static instruction count: every instruction from the one after its OpLabel to its
 // terminator, both included, except OpLine/OpNoLine (debug annotations). OpPhi, OpVariable and
