@@ -10,11 +10,14 @@
 #include <sstream>
 #include <sys/wait.h>
 
+#include "tests/test_support.h"
 #include "renderers/vulkan/cpu_caps.h"
 
 using namespace iblcheck;
 
 namespace {
+
+using namespace iblcheck::testutil;
 
 // This project's machine (AMD EPYC, `flags` of /proc/cpuinfo, abridged to what matters plus noise).
 const char* kEpyc = "fpu vme de pse tsc msr pae mce cx8 apic sep mtrr pge mca cmov pat pse36 clflush mmx fxsr sse sse2 "
@@ -25,14 +28,6 @@ const char* kIvyBridge = "fpu sse sse2 pni ssse3 sse4_1 sse4_2 popcnt xsave avx 
 // A Nehalem: SSE4.2, no AVX.
 const char* kNehalem = "fpu sse sse2 pni ssse3 sse4_1 sse4_2 popcnt";
 
-int run_command(const std::string& cmd, std::string& output) {
-    FILE* pipe = popen((cmd + " 2>&1").c_str(), "r");
-    std::array<char, 512> buf;
-    output.clear();
-    while (fgets(buf.data(), buf.size(), pipe)) output += buf.data();
-    int status = pclose(pipe);
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
 
 } // namespace
 

@@ -15,6 +15,7 @@
 #include <random>
 #include <sys/wait.h>
 
+#include "tests/test_support.h"
 #include "harness/common/errors.h"
 #include "renderers/vulkan/context.h"
 #include "renderers/vulkan/fp16_emulation.h"
@@ -24,20 +25,9 @@ using namespace iblcheck;
 
 namespace {
 
-fs::path temp_dir(const std::string& name) {
-    fs::path p = fs::temp_directory_path() / ("iblcheck_fp16_" + name + "_" + std::to_string(::getpid()));
-    fs::create_directories(p);
-    return p;
-}
+using namespace iblcheck::testutil;
 
-int run_command(const std::string& cmd, std::string& output) {
-    FILE* pipe = popen((cmd + " 2>&1").c_str(), "r");
-    std::array<char, 512> buf;
-    output.clear();
-    while (fgets(buf.data(), buf.size(), pipe)) output += buf.data();
-    int status = pclose(pipe);
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
+
 
 vk::Context& context() {
     static vk::Context ctx({"", true});

@@ -15,6 +15,7 @@
 #include <fstream>
 #include <limits>
 
+#include "tests/test_support.h"
 #include "harness/common/errors.h"
 #include "harness/golden_store.h"
 #include "harness/runner.h"
@@ -26,28 +27,12 @@ using nlohmann::json;
 
 namespace {
 
-fs::path temp_dir(const std::string& name) {
-    fs::path p = fs::temp_directory_path() / ("iblcheck_holes_" + name + "_" + std::to_string(::getpid()));
-    fs::remove_all(p);
-    fs::create_directories(p);
-    return p;
-}
+using namespace iblcheck::testutil;
 
-int run_command(const std::string& cmd, std::string& out) {
-    FILE* pipe = popen((cmd + " 2>&1").c_str(), "r");
-    std::array<char, 512> buf;
-    out.clear();
-    while (fgets(buf.data(), buf.size(), pipe)) out += buf.data();
-    int status = pclose(pipe);
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
+
 
 std::string bin(const std::string& name) { return std::string(IBLCHECK_BINARY_DIR) + "/" + name; }
 
-std::string read_text(const fs::path& p) {
-    std::ifstream f(p);
-    return std::string(std::istreambuf_iterator<char>(f), {});
-}
 
 const char* kMiniSuite = R"({
   "suite": "mini",

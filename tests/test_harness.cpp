@@ -10,6 +10,7 @@
 #include <set>
 #include <sys/wait.h>
 
+#include "tests/test_support.h"
 #include "harness/common/errors.h"
 #include "harness/golden_store.h"
 #include "harness/runner.h"
@@ -21,26 +22,10 @@ using nlohmann::json;
 
 namespace {
 
-fs::path temp_dir(const std::string& name) {
-    fs::path p = fs::temp_directory_path() / ("iblcheck_harness_" + name + "_" + std::to_string(::getpid()));
-    fs::remove_all(p);
-    fs::create_directories(p);
-    return p;
-}
+using namespace iblcheck::testutil;
 
-void write_file(const fs::path& p, const std::string& text) {
-    fs::create_directories(p.parent_path());
-    std::ofstream(p) << text;
-}
 
-int run_command(const std::string& cmd, std::string& out) {
-    FILE* pipe = popen((cmd + " 2>&1").c_str(), "r");
-    std::array<char, 512> buf;
-    out.clear();
-    while (fgets(buf.data(), buf.size(), pipe)) out += buf.data();
-    int status = pclose(pipe);
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
+
 
 std::string iblcheck_bin() { return std::string(IBLCHECK_BINARY_DIR) + "/iblcheck"; }
 

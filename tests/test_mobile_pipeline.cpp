@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "tests/test_support.h"
 #include "metrics/flip.h"
 #include "metrics/image_io.h"
 #include "renderers/environments/environment.h"
@@ -25,6 +26,8 @@
 using namespace iblcheck;
 
 namespace {
+
+using namespace iblcheck::testutil;
 
 GpuSession& session() {
     static GpuSession s(vk::ContextOptions{"", true});
@@ -140,14 +143,6 @@ void expect_within_fp16_bound(const ImageDifference& d) {
     EXPECT_LT(d.differing, kFp16Differing) << d;
 }
 
-int run_command(const std::string& cmd, std::string& output) {
-    FILE* pipe = popen(cmd.c_str(), "r");
-    std::array<char, 512> buf;
-    output.clear();
-    while (fgets(buf.data(), buf.size(), pipe)) output += buf.data();
-    int status = pclose(pipe);
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
 
 } // namespace
 
@@ -349,10 +344,6 @@ RenderResult render_in(GpuSession& gpu, const TestSpec& s) {
     return s.method == "sampled" ? render_sampled(gpu, env, s) : render_mobile(gpu, env, s);
 }
 
-std::string read_text(const std::filesystem::path& p) {
-    std::ifstream in(p);
-    return std::string(std::istreambuf_iterator<char>(in), {});
-}
 
 bool identical(const cv::Mat& a, const cv::Mat& b) {
     return a.size() == b.size() && std::memcmp(a.data, b.data, a.total() * a.elemSize()) == 0;
@@ -414,7 +405,7 @@ TEST(MobileCost, CountIsIdenticalOnAnotherCpuClassAndOneThread) {
             int rc = run_command(env + " " + std::string(IBLCHECK_BINARY_DIR) + "/iblcheck render --scene roughness_sweep --method " +
                                      s->method + " --env sky_sun" + (s == &sampled ? " --set samples=64" : "") +
                                      " --json - 2>/dev/null",
-                                 out);
+                                 out, false);
             ASSERT_EQ(rc, 0) << env << ": " << out;
             nlohmann::json j = nlohmann::json::parse(out);
             EXPECT_EQ(j["shader_instructions_per_pixel"].get<double>(), here) << s->method << ", " << env;
@@ -528,7 +519,7 @@ TEST(MobileFp16, RendersWithoutShaderFloat16InAChildProcess) {
     int rc = run_command("GALLIUM_OVERRIDE_CPU_CAPS=sse4.1 " + bin +
                              " render --scene roughness_sweep --method mobile --env sky_sun --set precision=mediump"
                              " --out " + exr + " --json - 2>" + err,
-                         out);
+                         out, false);
     ASSERT_EQ(rc, 0) << out;
     nlohmann::json j = nlohmann::json::parse(out);
     EXPECT_EQ(j["provenance"].value("fp16", ""), "emulated") << out;
@@ -545,7 +536,7 @@ TEST(MobileFp16, RendersWithoutShaderFloat16InAChildProcess) {
     // fp16=native is a clear environment error there, not a crash or a silent fallback.
     rc = run_command("GALLIUM_OVERRIDE_CPU_CAPS=sse4.1 " + bin +
                          " render --scene sphere --method mobile --env studio --set precision=mediump --set fp16=native 2>&1",
-                     out);
+                     out, false);
     EXPECT_EQ(rc, 2) << out;
     EXPECT_NE(out.find("fp16=native needs shaderFloat16"), std::string::npos) << out;
     fs::remove_all(dir);

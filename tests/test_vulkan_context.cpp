@@ -10,6 +10,7 @@
 #include <fstream>
 #include <sys/wait.h>
 
+#include "tests/test_support.h"
 #include "harness/common/errors.h"
 #include "renderers/vulkan/context.h"
 #include "renderers/vulkan/fp16_emulation.h"
@@ -19,26 +20,11 @@ using namespace iblcheck;
 
 namespace {
 
-fs::path temp_dir(const std::string& name) {
-    fs::path p = fs::temp_directory_path() / ("iblcheck_test_" + name + "_" + std::to_string(::getpid()));
-    fs::create_directories(p);
-    return p;
-}
+using namespace iblcheck::testutil;
 
-void write_file(const fs::path& p, const std::string& text) {
-    std::ofstream f(p);
-    f << text;
-}
+
 
 // Runs a shell command, returns its exit status and output (stdout + stderr).
-int run_command(const std::string& cmd, std::string& output) {
-    FILE* pipe = popen((cmd + " 2>&1").c_str(), "r");
-    std::array<char, 512> buf;
-    output.clear();
-    while (fgets(buf.data(), buf.size(), pipe)) output += buf.data();
-    int status = pclose(pipe);
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
 
 std::vector<float> run_shader(vk::Context& ctx, const vk::CompiledShader& shader, uint32_t n) {
     vk::Buffer buf = ctx.create_buffer(n * 4);
