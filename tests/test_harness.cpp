@@ -154,7 +154,9 @@ TEST(Harness, MissingGoldenThenBlessThenPassThenImproved) {
     EXPECT_EQ(s3.improved, 1);
     EXPECT_EQ(s3.exit_code(), kExitPass);
     for (auto& t : s3.results["tests"])
-        if (t["verdict"] == "improved") EXPECT_NE(t["message"].get<std::string>().find("tighten"), std::string::npos);
+        if (t["verdict"] == "improved") {
+            EXPECT_NE(t["message"].get<std::string>().find("tighten"), std::string::npos);
+        }
 
     // A second approved baseline (@label) is accepted when the primary no longer matches.
     cv::Mat img = GoldenStore(goldens).baselines("mobile.furnace.constant:1.default")[0].image.clone();
@@ -221,7 +223,9 @@ TEST(Gate, ShaderChangeFailsExactlyTheAffectedCiTestsAndBisectFollowsTheContract
         bool approx = t["method"] == "mobile" && name.find("env_brdf=lut") == std::string::npos;
         EXPECT_EQ(t["verdict"], approx ? "fail" : "pass") << name << ": " << t["message"];
         failed += t["verdict"] == "fail";
-        if (approx) EXPECT_NE(t["message"].get<std::string>().find("worst 16x16 block at"), std::string::npos);
+        if (approx) {
+            EXPECT_NE(t["message"].get<std::string>().find("worst 16x16 block at"), std::string::npos);
+        }
     }
     EXPECT_GE(failed, 20);
 
