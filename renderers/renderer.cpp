@@ -21,48 +21,6 @@ std::vector<MethodInfo> method_catalog() {
     };
 }
 
-std::vector<OptionInfo> option_catalog() {
-    return {
-        {"roughness", "0.5", "0..1", "all", "perceptual roughness of the `sphere` scene (alpha = r^2)"},
-        {"metallic", "0", "0..1", "all", "metalness of the `sphere` scene"},
-        {"base_color", "1,1,1", "r,g,b", "all", "base colour of the `sphere` scene"},
-        {"env_rotation", "0", "degrees", "all", "turns the environment about +Y"},
-        {"frame", "0", "integer", "all", "frame of an animated scene (bumpy_sphere)"},
-        {"bump_amplitude", "0.0008", ">=0", "all", "height of the bumpy_sphere normal detail"},
-        {"roughness_bias", "0", "-1..1", "all", "stability: added to every sphere's roughness"},
-        {"camera_shift", "0", "pixels x,y,0", "all", "stability: moves the camera by a fraction of a pixel"},
-        {"bump_frequency", "200", ">0", "all", "spatial frequency of the bumpy_sphere normal detail (radius-1 units)"},
-        {"ssaa", "2", "1..16", "mobile,sampled", "n x n rays per pixel (silhouettes)"},
-        {"cube_size", "128 (sampled: 256)", "8..2048, power of two", "mobile,sampled", "base size of the cubemaps"},
-        {"mips", "7", "1..log2(cube_size)+1", "mobile", "levels of the prefiltered chain"},
-        {"prefilter_samples", "64", "1..65536", "mobile", "GGX samples per prefiltered texel"},
-        {"mip_mapping", "ue4", "ue4|filament|origin", "mobile", "roughness <-> mip mapping"},
-        {"env_brdf", "approx", "approx|lut", "mobile", "EnvBRDFApprox (Karis/Lazarov) or a DFG LUT pass"},
-        {"lut_size", "64", "8..512", "mobile", "DFG LUT resolution (env_brdf=lut)"},
-        {"diffuse", "sh9", "sh9|irradiance_cube", "mobile", "diffuse irradiance representation"},
-        {"dominant_dir", "off", "off|lagarde|filament", "mobile", "specular dominant direction"},
-        {"normalization", "off", "off|ue4", "mobile", "UE4 mobile reflection normalisation (MixingAlpha)"},
-        {"mix_begin_roughness", "0.1", "0..1", "mobile", "normalisation: roughness where mixing starts"},
-        {"mix_end_roughness", "0.3", "0..1", "mobile", "normalisation: roughness where mixing is full"},
-        {"mix_largest_weight", "10000", ">0", "mobile", "normalisation: clamp of the mixing weight"},
-        {"indirect_irradiance", "sh9", "sh9|number", "mobile", "normalisation: lightmap/ILC brightness"},
-        {"storage", "rgba16f", "rgba16f|rgba32f|rgbm8|r11g11b10", "mobile", "prefiltered cube storage"},
-        {"rgbm_range", "6", ">0", "mobile", "RGBM range (storage=rgbm8)"},
-        {"precision", "highp", "highp|mediump", "mobile", "mediump shades in float16_t"},
-        {"fp16", "auto", "auto|native|emulated", "mobile",
-         "precision=mediump: native float16_t, or emulated (fp32 rounded to fp16 per operation); auto: native if shaderFloat16"},
-        {"specular_aa", "off", "off|tokuyoshi|rjump|toksvig", "mobile", "specular anti-aliasing for low roughness"},
-        {"specular_aa_variance", "0.25", ">=0", "mobile", "specular AA: screen-space variance scale"},
-        {"specular_aa_threshold", "0.18", ">=0", "mobile", "specular AA: clamp of the added roughness"},
-        {"samples", "64", "1..65536", "sampled", "GGX samples per ray"},
-        {"min_lod", "0", ">=0", "sampled", "lowest mip a sample may read"},
-        {"diffuse_roughness", "0.9", "0..1", "sampled", "roughness from which radiance blends to irradiance"},
-        {"seed", "0", "integer", "sampled,reference", "random seed"},
-        {"spp", "256", ">=1", "reference", "samples per pixel"},
-        {"threads", "0", ">=0", "reference", "CPU threads (0: all)"},
-    };
-}
-
 void validate_spec(const TestSpec& spec) {
     bool known_method = false;
     std::string names;
@@ -73,20 +31,12 @@ void validate_spec(const TestSpec& spec) {
     if (!known_method) throw UsageError("unknown method '" + spec.method + "'; valid: " + names);
     std::set<std::string> known;
     for (auto& o : option_catalog())
-        if (o.methods == "all" || o.methods.find(spec.method) != std::string::npos) known.insert(o.key);
+        if (o.read_by(spec.method)) known.insert(o.key);
     spec.options.check_known(known, "method " + spec.method);
-    // Enumerated values ("a|b|c" in the catalogue) are checked here too, so a suite file with a
-    // misspelt variant fails when it is loaded, not halfway through a run.
-    for (auto& o : option_catalog()) {
-        if (!spec.options.has(o.key) || o.values.find('|') == std::string::npos || o.values.find("number") != std::string::npos)
-            continue;
-        std::vector<std::string> allowed;
-        size_t start = 0;
-        for (size_t bar; (bar = o.values.find('|', start)) != std::string::npos; start = bar + 1)
-            allowed.push_back(o.values.substr(start, bar - start));
-        allowed.push_back(o.values.substr(start));
-        spec.options.get_choice(o.key, allowed[0], allowed);
-    }
+    // Enumerated values are checked here too, so a suite file with a misspelt variant fails when
+    // it is loaded, not halfway through a run.
+    for (auto& o : option_catalog())
+        if (o.enumerated() && spec.options.has(o.key)) option_choice(spec.options, o.key);
     build_scene(spec.scene, spec.options);  // unknown scene or bad material option: UsageError
 }
 

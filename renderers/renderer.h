@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "option_table.h"
 #include "render_api.h"
 #include "renderers/vulkan/context.h"
 
@@ -19,15 +20,6 @@ struct MethodInfo {
     std::string description;
 };
 std::vector<MethodInfo> method_catalog();
-
-struct OptionInfo {
-    std::string key;
-    std::string default_value;
-    std::string values;      // "ue4|filament|origin" or a range/description
-    std::string methods;     // "mobile", "mobile,sampled", "all"
-    std::string description;
-};
-std::vector<OptionInfo> option_catalog();
 
 // Throws UsageError for an unknown method, or an option key that `method` does not read.
 void validate_spec(const TestSpec& spec);

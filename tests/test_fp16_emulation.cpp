@@ -17,6 +17,7 @@
 
 #include "tests/test_support.h"
 #include "harness/common/errors.h"
+#include "renderers/option_table.h"
 #include "renderers/vulkan/context.h"
 #include "renderers/vulkan/fp16_emulation.h"
 
@@ -177,9 +178,14 @@ TEST(Fp16EmulationPass, OutputValidatesWithoutAnyFloat16) {
 TEST(Fp16EmulationPass, ShadeSpheresMediumpValidatesInEveryVariant) {
     // The shader the option is for, in the variants that use different fp16 code (dominant
     // direction with sqrt, normalisation with smoothstep and a division, the LUT path).
-    for (const vk::Defines& d : {vk::Defines{{"PRECISION_MEDIUMP", "1"}},
-                                 vk::Defines{{"PRECISION_MEDIUMP", "1"}, {"DOMINANT_DIR", "1"}, {"NORMALIZATION", "1"}},
-                                 vk::Defines{{"PRECISION_MEDIUMP", "1"}, {"DOMINANT_DIR", "2"}, {"ENV_BRDF", "1"}}}) {
+    auto mediump = [](std::map<std::string, std::string> set) {
+        OptionMap o;
+        o.set("precision", "mediump");
+        for (const auto& [k, v] : set) o.set(k, v);
+        return glsl_defines(shader_selections(o, "mobile"));
+    };
+    for (const vk::Defines& d : {mediump({}), mediump({{"dominant_dir", "lagarde"}, {"normalization", "ue4"}}),
+                                 mediump({{"dominant_dir", "filament"}, {"env_brdf", "lut"}})}) {
         vk::CompileOptions opt;
         opt.emulate_fp16 = true;
         vk::CompiledShader s = vk::compile_compute_shader("shade_spheres.comp", d, opt);
@@ -191,7 +197,8 @@ TEST(Fp16EmulationPass, ShadeSpheresMediumpValidatesInEveryVariant) {
 }
 
 TEST(Fp16EmulationPass, ModuleWithoutFp16IsLeftAlone) {
-    vk::CompiledShader highp = vk::compile_compute_shader("shade_spheres.comp", {{"PRECISION_MEDIUMP", "0"}});
+    vk::CompiledShader highp =
+        vk::compile_compute_shader("shade_spheres.comp", glsl_defines(shader_selections(OptionMap{}, "mobile")));
     std::vector<uint32_t> m = highp.spirv;
     EXPECT_FALSE(vk::emulate_fp16(m));
     EXPECT_EQ(m, highp.spirv);

@@ -5,6 +5,7 @@
 #include <cstring>
 
 #include "harness/common/errors.h"
+#include "renderers/option_table.h"
 
 namespace iblcheck {
 
@@ -26,17 +27,8 @@ VkFormat storage_format(const std::string& storage, bool native_r11g11b10) {
 
 } // namespace
 
-std::string mip_mapping_define(const std::string& name) {
-    if (name == "ue4") return "0";
-    if (name == "filament") return "1";
-    if (name == "origin") return "2";
-    throw UsageError("option 'mip_mapping': unknown value '" + name + "'; valid: ue4, filament, origin");
-}
-
 vk::Defines storage_defines(const PrecomputeSettings& s, bool native_r11g11b10) {
-    vk::Defines d;
-    const char* id = s.storage == "rgba32f" ? "0" : s.storage == "rgba16f" ? "1" : s.storage == "rgbm8" ? "2" : "3";
-    d["STORAGE"] = id;
+    vk::Defines d = glsl_defines({{"storage", s.storage}, {"mip_mapping", s.mip_mapping}});
     if (s.storage == "rgbm8") d["RGBM_RANGE"] = std::to_string(s.rgbm_range);
     if (s.storage == "r11g11b10" && native_r11g11b10) d["STORAGE_NATIVE_R11G11B10"] = "1";
     return d;
@@ -85,9 +77,7 @@ IblResources run_precompute(GpuSession& gpu, const Environment& env, const Preco
 
     const auto& p_e2c = gpu.pipeline("equirect_to_cube.comp", {}, {kSampled, kStorageImage}, 12);
     const auto& p_down = gpu.pipeline("downsample_cube.comp", {}, {kStorageImage, kStorageImage}, 4);
-    vk::Defines pdefs = storage_defines(s, r.native_r11g11b10);
-    pdefs["MIP_MAPPING"] = mip_mapping_define(s.mip_mapping);
-    const auto& p_pre = gpu.pipeline("prefilter_ggx.comp", pdefs, {kSampled, kStorageImage}, 28);
+    const auto& p_pre = gpu.pipeline("prefilter_ggx.comp", storage_defines(s, r.native_r11g11b10), {kSampled, kStorageImage}, 28);
     const auto& p_sh = gpu.pipeline("sh9_project.comp", {}, {kStorageImage, kStorageBuffer}, 4);
 
     vk::GpuTimer timer(ctx, 8);

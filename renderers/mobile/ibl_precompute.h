@@ -47,8 +47,9 @@ IblResources run_precompute(GpuSession& gpu, const Environment& env, const Preco
 std::shared_ptr<IblResources> precompute_cached(GpuSession& gpu, const Environment& env, const PrecomputeSettings& s,
                                                 std::vector<PassTiming>& timings, bool& cached);
 
-// Defines that select the storage format in GLSL (storage.glsl).
+// The defines of the passes that read or write the prefiltered chain: the option table's for
+// storage and mip_mapping (storage.glsl, mip_mapping.glsl), plus the RGBM range and whether
+// R11G11B10 is stored natively.
 vk::Defines storage_defines(const PrecomputeSettings& s, bool native_r11g11b10);
-std::string mip_mapping_define(const std::string& name);
 
 } // namespace iblcheck

@@ -5,6 +5,7 @@
 
 #include "gpu_scene.h"
 #include "harness/common/errors.h"
+#include "renderers/option_table.h"
 #include "ibl_precompute.h"
 #include "renderers/scenes/scene.h"
 #include "shading_cost.h"
@@ -16,11 +17,6 @@ namespace {
 constexpr VkDescriptorType kSampled = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
 constexpr VkDescriptorType kStorageBuffer = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
 
-std::string index_of(const std::string& key, const std::string& value, const std::vector<std::string>& names) {
-    for (size_t i = 0; i < names.size(); ++i)
-        if (names[i] == value) return std::to_string(i);
-    throw UsageError("option '" + key + "': unknown value '" + value + "'");
-}
 } // namespace
 
 RenderResult render_mobile(GpuSession& gpu, const Environment& env, const TestSpec& spec) {
@@ -32,26 +28,21 @@ RenderResult render_mobile(GpuSession& gpu, const Environment& env, const TestSp
     ps.cube_size = uint32_t(o.get_int("cube_size", 128));
     ps.mips = uint32_t(o.get_int("mips", 7));
     ps.prefilter_samples = uint32_t(o.get_int("prefilter_samples", 64));
-    ps.mip_mapping = o.get_choice("mip_mapping", "ue4", {"ue4", "filament", "origin"});
-    ps.storage = o.get_choice("storage", "rgba16f", {"rgba16f", "rgba32f", "rgbm8", "r11g11b10"});
+    const std::map<std::string, std::string> variant = shader_selections(o, "mobile");
+    ps.mip_mapping = variant.at("mip_mapping");
+    ps.storage = variant.at("storage");
     ps.rgbm_range = float(o.get_double("rgbm_range", 6.0));
-    std::string env_brdf = o.get_choice("env_brdf", "approx", {"approx", "lut"});
-    std::string diffuse = o.get_choice("diffuse", "sh9", {"sh9", "irradiance_cube"});
-    ps.lut = env_brdf == "lut";
+    ps.lut = variant.at("env_brdf") == "lut";
     ps.lut_size = uint32_t(o.get_int("lut_size", 64));
-    ps.irradiance_cube = diffuse == "irradiance_cube";
+    ps.irradiance_cube = variant.at("diffuse") == "irradiance_cube";
     ps.env_rotation_deg = float(o.get_double("env_rotation", 0.0));
-    std::string precision = o.get_choice("precision", "highp", {"highp", "mediump"});
-    std::string dominant = o.get_choice("dominant_dir", "off", {"off", "lagarde", "filament"});
-    std::string normalization = o.get_choice("normalization", "off", {"off", "ue4"});
-    std::string spec_aa = o.get_choice("specular_aa", "off", {"off", "tokuyoshi", "rjump", "toksvig"});
     if (ps.prefilter_samples < 1 || ps.prefilter_samples > 65536)
         throw UsageError("option 'prefilter_samples' must be in 1..65536");
-    std::string fp16 = o.get_choice("fp16", "auto", {"auto", "native", "emulated"});
+    std::string fp16 = option_choice(o, "fp16");
     // precision=mediump computes in float16_t: natively, or emulated where the device lacks
     // shaderFloat16 (or fp16=emulated asks for it). One rule, shared with `iblcheck doctor`.
     std::optional<vk::Fp16Path> fp16_path;
-    if (precision == "mediump")
+    if (variant.at("precision") == "mediump")
         fp16_path = vk::choose_fp16_path(fp16, gpu.ctx().info().shader_float16, gpu.ctx().info().device_name);
     vk::CompileOptions shade_options;
     shade_options.emulate_fp16 = fp16_path == vk::Fp16Path::emulated;
@@ -62,13 +53,7 @@ RenderResult render_mobile(GpuSession& gpu, const Environment& env, const TestSp
     const IblResources& ibl = *ibl_ptr;
 
     vk::Defines defs = storage_defines(ps, ibl.native_r11g11b10);
-    defs["MIP_MAPPING"] = mip_mapping_define(ps.mip_mapping);
-    defs["ENV_BRDF"] = index_of("env_brdf", env_brdf, {"approx", "lut"});
-    defs["DIFFUSE"] = index_of("diffuse", diffuse, {"sh9", "irradiance_cube"});
-    defs["DOMINANT_DIR"] = index_of("dominant_dir", dominant, {"off", "lagarde", "filament"});
-    defs["NORMALIZATION"] = index_of("normalization", normalization, {"off", "ue4"});
-    defs["PRECISION_MEDIUMP"] = precision == "mediump" ? "1" : "0";
-    defs["SPECULAR_AA"] = index_of("specular_aa", spec_aa, {"off", "tokuyoshi", "rjump", "toksvig"});
+    defs.merge(glsl_defines(variant));  // keeps storage_defines' entries; adds the other selections
     const std::vector<VkDescriptorType> types = {kStorageBuffer, kSampled, kStorageBuffer, kSampled, kSampled, kStorageBuffer};
     const auto& shade = gpu.pipeline("shade_spheres.comp", defs, types, 48, shade_options);
 
@@ -123,7 +108,7 @@ RenderResult render_mobile(GpuSession& gpu, const Environment& env, const TestSp
                          {"cube_size", ps.cube_size},
                          {"mips", std::min(ps.mips, ibl.full_mips)},
                          {"storage_native", ps.storage != "r11g11b10" || ibl.native_r11g11b10},
-                         {"shader_defines", defs}};
+                         {"shader_variant", glsl_selection_names(variant)}};
     if (fp16_path) result.provenance["fp16"] = vk::fp16_path_name(*fp16_path);
     return result;
 }

@@ -1,9 +1,9 @@
-// The split sum's second factor (option env_brdf). ENV_BRDF: 0 approx, 1 lut.
+// The split sum's second factor (option env_brdf, define ENV_BRDF).
 #ifndef IBLCHECK_ENV_BRDF_GLSL
 #define IBLCHECK_ENV_BRDF_GLSL
 #include "precision.glsl"
 #ifndef ENV_BRDF
-#define ENV_BRDF 0
+#error "ENV_BRDF is set from the option table (renderers/option_table.cpp)"
 #endif
 
 // EnvBRDFApprox: Karis 2014, "Physically Based Shading on Mobile" (after Lazarov 2013, "Getting

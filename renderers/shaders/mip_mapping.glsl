@@ -1,13 +1,13 @@
 // Roughness ↔ mip level of the prefiltered cube (option mip_mapping). The prefilter pass writes
 // mip m with roughness lod_to_roughness(m); shading reads at roughness_to_lod(r): the same mapping,
-// inverted. MIP_MAPPING: 0 ue4, 1 filament, 2 origin.
+// inverted (define MIP_MAPPING).
 //   full_mips = log2(base size) + 1 (UE4's CubemapMaxMip: the whole chain down to 1×1)
 //   max_lod   = stored mip count − 1
 #ifndef IBLCHECK_MIP_MAPPING_GLSL
 #define IBLCHECK_MIP_MAPPING_GLSL
 
 #ifndef MIP_MAPPING
-#define MIP_MAPPING 0
+#error "MIP_MAPPING is set from the option table (renderers/option_table.cpp)"
 #endif
 
 // UE4 ReflectionEnvironmentShared.ush: REFLECTION_CAPTURE_ROUGHEST_MIP 1,
@@ -21,23 +21,23 @@ const float REFLECTION_CAPTURE_ROUGHNESS_MIP_SCALE = 1.2;
 const float ORIGIN_CURVE_K = 32.0;
 
 float roughness_to_lod(float r, float full_mips, float max_lod) {
-#if MIP_MAPPING == 0
+#if MIP_MAPPING == MIP_MAPPING_UE4
     float level_from_1x1 = REFLECTION_CAPTURE_ROUGHEST_MIP - REFLECTION_CAPTURE_ROUGHNESS_MIP_SCALE * log2(max(r, 1e-6));
     return clamp(full_mips - 1.0 - level_from_1x1, 0.0, max_lod);
-#elif MIP_MAPPING == 1
+#elif MIP_MAPPING == MIP_MAPPING_FILAMENT
     // Filament (ibl/CubemapIBL, shading: perceptualRoughnessToLod): lod = max_lod · r(2 − r).
     return clamp(max_lod * r * (2.0 - r), 0.0, max_lod);
-#else
+#elif MIP_MAPPING == MIP_MAPPING_ORIGIN
     return clamp(max_lod * log2(1.0 + ORIGIN_CURVE_K * r) / log2(1.0 + ORIGIN_CURVE_K), 0.0, max_lod);
 #endif
 }
 
 float lod_to_roughness(float lod, float full_mips, float max_lod) {
-#if MIP_MAPPING == 0
+#if MIP_MAPPING == MIP_MAPPING_UE4
     return clamp(exp2((lod - full_mips + 1.0 + REFLECTION_CAPTURE_ROUGHEST_MIP) / REFLECTION_CAPTURE_ROUGHNESS_MIP_SCALE), 0.0, 1.0);
-#elif MIP_MAPPING == 1
+#elif MIP_MAPPING == MIP_MAPPING_FILAMENT
     return clamp(1.0 - sqrt(max(0.0, 1.0 - lod / max_lod)), 0.0, 1.0);
-#else
+#elif MIP_MAPPING == MIP_MAPPING_ORIGIN
     return clamp((exp2(lod / max_lod * log2(1.0 + ORIGIN_CURVE_K)) - 1.0) / ORIGIN_CURVE_K, 0.0, 1.0);
 #endif
 }

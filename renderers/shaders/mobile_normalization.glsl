@@ -1,5 +1,5 @@
 // UE4's mobile reflection normalisation (option normalization; second seed, and UE4's
-// ReflectionEnvironmentShared.ush ComputeMixingWeight). NORMALIZATION: 0 off, 1 ue4.
+// ReflectionEnvironmentShared.ush ComputeMixingWeight).
 //   MixingAlpha  = smoothstep(0, 1, saturate((r − begin) / (end − begin)))
 //   MixingWeight = min(indirect_irradiance / max(average_brightness, 1e-4), largest_weight)
 //   scale        = lerp(1, MixingWeight, MixingAlpha)
@@ -11,12 +11,12 @@
 #define IBLCHECK_MOBILE_NORMALIZATION_GLSL
 #include "precision.glsl"
 #ifndef NORMALIZATION
-#define NORMALIZATION 0
+#error "NORMALIZATION is set from the option table (renderers/option_table.cpp)"
 #endif
 
 hfloat reflection_mixing_scale(hfloat roughness, hfloat indirect_irradiance, hfloat average_brightness,
                                hfloat begin_roughness, hfloat end_roughness, hfloat largest_weight) {
-#if NORMALIZATION == 1
+#if NORMALIZATION == NORMALIZATION_UE4
     hfloat alpha = smoothstep(hfloat(0.0), hfloat(1.0),
                               clamp((roughness - begin_roughness) / (end_roughness - begin_roughness), hfloat(0.0), hfloat(1.0)));
     hfloat weight = min(indirect_irradiance / max(average_brightness, hfloat(1e-4)), largest_weight);

@@ -1,4 +1,4 @@
-// Shading precision (option precision). PRECISION_MEDIUMP 1 computes the shading in explicit
+// Shading precision (option precision). PRECISION == PRECISION_MEDIUMP computes the shading in explicit
 // float16_t: lavapipe ignores the mediump qualifier (RelaxedPrecision) but computes float16_t as
 // true fp16, so this is what a mobile GPU's half precision does to the result (max 65504,
 // 11-bit mantissa). Without shaderFloat16 the host emulates it (option fp16,
@@ -6,10 +6,10 @@
 // operation.
 #ifndef IBLCHECK_PRECISION_GLSL
 #define IBLCHECK_PRECISION_GLSL
-#ifndef PRECISION_MEDIUMP
-#define PRECISION_MEDIUMP 0
+#ifndef PRECISION
+#error "PRECISION is set from the option table (renderers/option_table.cpp)"
 #endif
-#if PRECISION_MEDIUMP
+#if PRECISION == PRECISION_MEDIUMP
 #extension GL_EXT_shader_explicit_arithmetic_types_float16 : require
 #define hfloat float16_t
 #define hvec2 f16vec2

@@ -3,8 +3,7 @@
 // against the analytic spheres (exact normals) and shades every hit with
 //   color = (1 − m)·c·E(n)/π  +  prefiltered(dir, lod(r)) · (F0·A + B) · normalisation
 // (Karis 2013, "Real Shading in Unreal Engine 4", split-sum approximation, eq. 3). Variants are
-// defines named as the options: MIP_MAPPING, ENV_BRDF, DOMINANT_DIR, NORMALIZATION, STORAGE,
-// PRECISION_MEDIUMP, DIFFUSE, SPECULAR_AA.
+// defines from the option table (renderers/option_table.cpp).
 #include "common.glsl"
 #include "scene.glsl"
 #include "mip_mapping.glsl"
@@ -17,7 +16,7 @@
 #include "specular_aa.glsl"
 
 #ifndef DIFFUSE
-#define DIFFUSE 0   // 0 sh9, 1 irradiance_cube
+#error "DIFFUSE is set from the option table (renderers/option_table.cpp)"
 #endif
 
 layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;
@@ -42,7 +41,7 @@ layout(push_constant) uniform Push {
 } pc;
 
 vec3 diffuse_radiance(vec3 n) {
-#if DIFFUSE == 1
+#if DIFFUSE == DIFFUSE_IRRADIANCE_CUBE
     return textureLod(irradiance_cube, n, 0.0).rgb;
 #else
     return sh9_eval(sh.coeffs, n);
@@ -70,7 +69,7 @@ vec4 shade_ray(vec2 p) {
     float lod = roughness_to_lod(roughness, pc.full_mips, pc.max_lod);
     hvec3 spec_light = hvec3(decode_storage(textureLod(prefiltered, dir, lod)));
 
-#if ENV_BRDF == 1
+#if ENV_BRDF == ENV_BRDF_LUT
     hvec2 ab = hvec2(textureLod(dfg_lut, dfg_lut_uv(float(n_dot_v), roughness, float(textureSize(dfg_lut, 0).x)), 0.0).rg);
 #else
     hvec2 ab = env_brdf_approx(hr, n_dot_v);

@@ -1,5 +1,4 @@
-// Specular anti-aliasing for low roughness (option specular_aa). SPECULAR_AA: 0 off,
-// 1 tokuyoshi, 2 rjump, 3 toksvig. Each widens the GGX lobe where the normal (or the reflection
+// Specular anti-aliasing for low roughness (option specular_aa). Each widens the GGX lobe where the normal (or the reflection
 // vector) varies within a pixel, so the prefiltered lookup averages what the pixel covers instead
 // of point-sampling a highlight that then sparkles from frame to frame. Fresnel is untouched: only
 // the roughness changes. A compute shader has no dFdx, so the derivatives are forward differences
@@ -9,7 +8,7 @@
 #ifndef IBLCHECK_SPECULAR_AA_GLSL
 #define IBLCHECK_SPECULAR_AA_GLSL
 #ifndef SPECULAR_AA
-#define SPECULAR_AA 0
+#error "SPECULAR_AA is set from the option table (renderers/option_table.cpp)"
 #endif
 
 float roughness_from_alpha2(float alpha2) { return sqrt(sqrt(clamp(alpha2, 0.0, 1.0))); }
@@ -32,23 +31,23 @@ void surface_differences(vec2 p, vec2 size, vec3 n, vec3 v, out vec3 dn_dx, out 
 }
 
 float specular_aa_roughness(float roughness, vec3 n, vec3 v, vec2 p, vec2 size, float variance, float threshold) {
-#if SPECULAR_AA == 0
+#if SPECULAR_AA == SPECULAR_AA_OFF
     return roughness;
 #else
     float alpha2 = roughness * roughness * roughness * roughness;
     vec3 dn_dx, dn_dy, dr_dx, dr_dy;
-#if SPECULAR_AA == 1
+#if SPECULAR_AA == SPECULAR_AA_TOKUYOSHI
     // Tokuyoshi & Kaplanyan 2019, "Improved Geometric Specular Antialiasing" (eq. 13–14; the form
     // Filament ships): α'² = α² + min(2σ²(|∂n/∂x|² + |∂n/∂y|²), κ).
     surface_differences(p, size, n, v, dn_dx, dn_dy, dr_dx, dr_dy);
     float kernel = 2.0 * variance * (dot(dn_dx, dn_dx) + dot(dn_dy, dn_dy));
-#elif SPECULAR_AA == 2
+#elif SPECULAR_AA == SPECULAR_AA_RJUMP
     // The first seed's idea: find where the reflection vector R jumps across the pixel and widen the
     // lobe to cover the jump. R = 2(n·v)n − v moves about twice as fast as n (more at grazing
     // angles), hence the /4 that puts σ² on the same scale as tokuyoshi's.
     surface_differences(p, size, n, v, dn_dx, dn_dy, dr_dx, dr_dy);
     float kernel = 2.0 * variance * 0.25 * (dot(dr_dx, dr_dx) + dot(dr_dy, dr_dy));
-#else
+#elif SPECULAR_AA == SPECULAR_AA_TOKSVIG
     // Toksvig 2005, "Mipmapping Normal Maps": the mean of the normals over the pixel footprint is
     // shorter than 1 where they disagree; α'² = α² + (1 − |n̄|)/|n̄| (the GGX form in Hill's "Specular
     // Showdown"), scaled by σ²/0.25 so the variance option means the same for every variant.
@@ -61,6 +60,8 @@ float specular_aa_roughness(float roughness, vec3 n, vec3 v, vec2 p, vec2 size, 
         }
     float len = length(sum * 0.25);
     float kernel = 4.0 * variance * (1.0 - len) / max(len, 1e-4);  // = σ² at the default variance 0.25
+#else
+#error "SPECULAR_AA: a value without code here"
 #endif
     return roughness_from_alpha2(alpha2 + min(kernel, threshold));
 #endif

@@ -1,24 +1,23 @@
-// Cubemap storage of the prefiltered chain (option storage). STORAGE: 0 rgba32f, 1 rgba16f,
-// 2 rgbm8, 3 r11g11b10. Filtering happens on what is stored, as on a device: for RGBM that means
+// Cubemap storage of the prefiltered chain (option storage, define STORAGE). Filtering happens on what is stored, as on a device: for RGBM that means
 // bilinear interpolation of encoded values, one of the format's real artefacts.
 #ifndef IBLCHECK_STORAGE_GLSL
 #define IBLCHECK_STORAGE_GLSL
 
 #ifndef STORAGE
-#define STORAGE 0
+#error "STORAGE is set from the option table (renderers/option_table.cpp)"
 #endif
 // RGBM range (Karis, "RGBM color encoding", 2009: linear RGBM with range 6 as in UE3/UE4 captures).
 #ifndef RGBM_RANGE
 #define RGBM_RANGE 6.0
 #endif
 
-#if STORAGE == 0
+#if STORAGE == STORAGE_RGBA32F
 #define STORAGE_FORMAT rgba32f
-#elif STORAGE == 1
+#elif STORAGE == STORAGE_RGBA16F
 #define STORAGE_FORMAT rgba16f
-#elif STORAGE == 2
+#elif STORAGE == STORAGE_RGBM8
 #define STORAGE_FORMAT rgba8
-#else
+#elif STORAGE == STORAGE_R11G11B10
 // Stored in an rgba16f image after rounding to the packed format's precision (below), unless the
 // host found VK_FORMAT_B10G11R11_UFLOAT_PACK32 usable as a storage image (STORAGE_NATIVE_R11G11B10).
 #ifdef STORAGE_NATIVE_R11G11B10
@@ -41,11 +40,11 @@ float quantize_ufloat(float x, int mbits, float max_value) {
 
 vec4 encode_storage(vec3 c) {
     c = max(c, vec3(0.0));
-#if STORAGE == 2
+#if STORAGE == STORAGE_RGBM8
     float m = clamp(max(max(c.r, c.g), max(c.b, 1e-6)) / RGBM_RANGE, 0.0, 1.0);
     m = ceil(m * 255.0) / 255.0;
     return vec4(clamp(c / (m * RGBM_RANGE), 0.0, 1.0), m);
-#elif STORAGE == 3
+#elif STORAGE == STORAGE_R11G11B10
     return vec4(quantize_ufloat(c.r, 6, 65024.0), quantize_ufloat(c.g, 6, 65024.0), quantize_ufloat(c.b, 5, 64512.0), 1.0);
 #else
     return vec4(c, 1.0);
@@ -53,7 +52,7 @@ vec4 encode_storage(vec3 c) {
 }
 
 vec3 decode_storage(vec4 s) {
-#if STORAGE == 2
+#if STORAGE == STORAGE_RGBM8
     return s.rgb * s.a * RGBM_RANGE;
 #else
     return s.rgb;

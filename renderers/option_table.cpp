@@ -1,0 +1,144 @@
+#include "option_table.h"
+
+#include <algorithm>
+#include <cctype>
+#include <stdexcept>
+
+#include "harness/common/errors.h"
+
+namespace iblcheck {
+
+const std::vector<OptionInfo>& option_catalog() {
+    // key, default, values, methods, GLSL define, description
+    static const std::vector<OptionInfo> table = {
+        {"roughness", "0.5", "0..1", "all", "", "perceptual roughness of the `sphere` scene (alpha = r^2)"},
+        {"metallic", "0", "0..1", "all", "", "metalness of the `sphere` scene"},
+        {"base_color", "1,1,1", "r,g,b", "all", "", "base colour of the `sphere` scene"},
+        {"env_rotation", "0", "degrees", "all", "", "turns the environment about +Y"},
+        {"frame", "0", "integer", "all", "", "frame of an animated scene (bumpy_sphere)"},
+        {"bump_amplitude", "0.0008", ">=0", "all", "", "height of the bumpy_sphere normal detail"},
+        {"roughness_bias", "0", "-1..1", "all", "", "stability: added to every sphere's roughness"},
+        {"camera_shift", "0", "pixels x,y,0", "all", "", "stability: moves the camera by a fraction of a pixel"},
+        {"bump_frequency", "200", ">0", "all", "", "spatial frequency of the bumpy_sphere normal detail (radius-1 units)"},
+        {"ssaa", "2", "1..16", "mobile,sampled", "", "n x n rays per pixel (silhouettes)"},
+        {"cube_size", "128 (sampled: 256)", "8..2048, power of two", "mobile,sampled", "", "base size of the cubemaps"},
+        {"mips", "7", "1..log2(cube_size)+1", "mobile", "", "levels of the prefiltered chain"},
+        {"prefilter_samples", "64", "1..65536", "mobile", "", "GGX samples per prefiltered texel"},
+        {"mip_mapping", "ue4", "ue4|filament|origin", "mobile", "MIP_MAPPING", "roughness <-> mip mapping"},
+        {"env_brdf", "approx", "approx|lut", "mobile", "ENV_BRDF", "EnvBRDFApprox (Karis/Lazarov) or a DFG LUT pass"},
+        {"lut_size", "64", "8..512", "mobile", "", "DFG LUT resolution (env_brdf=lut)"},
+        {"diffuse", "sh9", "sh9|irradiance_cube", "mobile", "DIFFUSE", "diffuse irradiance representation"},
+        {"dominant_dir", "off", "off|lagarde|filament", "mobile", "DOMINANT_DIR", "specular dominant direction"},
+        {"normalization", "off", "off|ue4", "mobile", "NORMALIZATION", "UE4 mobile reflection normalisation (MixingAlpha)"},
+        {"mix_begin_roughness", "0.1", "0..1", "mobile", "", "normalisation: roughness where mixing starts"},
+        {"mix_end_roughness", "0.3", "0..1", "mobile", "", "normalisation: roughness where mixing is full"},
+        {"mix_largest_weight", "10000", ">0", "mobile", "", "normalisation: clamp of the mixing weight"},
+        {"indirect_irradiance", "sh9", "sh9 or a number", "mobile", "", "normalisation: lightmap/ILC brightness"},
+        {"storage", "rgba16f", "rgba16f|rgba32f|rgbm8|r11g11b10", "mobile", "STORAGE", "prefiltered cube storage"},
+        {"rgbm_range", "6", ">0", "mobile", "", "RGBM range (storage=rgbm8)"},
+        {"precision", "highp", "highp|mediump", "mobile", "PRECISION", "mediump shades in float16_t"},
+        {"fp16", "auto", "auto|native|emulated", "mobile", "",
+         "precision=mediump: native float16_t, or emulated (fp32 rounded to fp16 per operation); auto: native if shaderFloat16"},
+        {"specular_aa", "off", "off|tokuyoshi|rjump|toksvig", "mobile", "SPECULAR_AA", "specular anti-aliasing for low roughness"},
+        {"specular_aa_variance", "0.25", ">=0", "mobile", "", "specular AA: screen-space variance scale"},
+        {"specular_aa_threshold", "0.18", ">=0", "mobile", "", "specular AA: clamp of the added roughness"},
+        {"samples", "64", "1..65536", "sampled", "", "GGX samples per ray"},
+        {"min_lod", "0", ">=0", "sampled", "", "lowest mip a sample may read"},
+        {"diffuse_roughness", "0.9", "0..1", "sampled", "", "roughness from which radiance blends to irradiance"},
+        {"seed", "0", "integer", "sampled,reference", "", "random seed"},
+        {"spp", "256", ">=1", "reference", "", "samples per pixel"},
+        {"threads", "0", ">=0", "reference", "", "CPU threads (0: all)"},
+    };
+    return table;
+}
+
+std::vector<std::string> OptionInfo::choices() const {
+    std::vector<std::string> out;
+    if (!enumerated()) return out;
+    size_t start = 0;
+    for (size_t bar; (bar = values.find('|', start)) != std::string::npos; start = bar + 1)
+        out.push_back(values.substr(start, bar - start));
+    out.push_back(values.substr(start));
+    return out;
+}
+
+bool OptionInfo::read_by(const std::string& method) const {
+    if (methods == "all") return true;
+    size_t start = 0;
+    for (size_t comma; start <= methods.size(); start = comma + 1) {
+        comma = methods.find(',', start);
+        if (comma == std::string::npos) comma = methods.size();
+        if (methods.compare(start, comma - start, method) == 0 && comma - start == method.size()) return true;
+    }
+    return false;
+}
+
+const OptionInfo& option_info(const std::string& key) {
+    for (const auto& o : option_catalog())
+        if (o.key == key) return o;
+    throw std::logic_error("option '" + key + "' is not in the option table (renderers/option_table.cpp)");
+}
+
+std::string option_choice(const OptionMap& o, const std::string& key) {
+    const OptionInfo& info = option_info(key);
+    if (!info.enumerated()) throw std::logic_error("option '" + key + "' is not an enumeration");
+    return o.get_choice(key, info.default_value, info.choices());
+}
+
+std::string glsl_value_name(const OptionInfo& info, const std::string& value) {
+    std::string name = info.glsl_define + "_";
+    for (char c : value) name += std::isalnum(static_cast<unsigned char>(c)) ? char(std::toupper(static_cast<unsigned char>(c))) : '_';
+    return name;
+}
+
+namespace {
+size_t index_in_table(const OptionInfo& info, const std::string& value) {
+    auto choices = info.choices();
+    auto it = std::find(choices.begin(), choices.end(), value);
+    if (it == choices.end()) {
+        std::string valid;
+        for (const auto& c : choices) valid += (valid.empty() ? "" : ", ") + c;
+        throw UsageError("option '" + info.key + "': unknown value '" + value + "'; valid: " + valid);
+    }
+    return size_t(it - choices.begin());
+}
+
+const OptionInfo& shader_option(const std::string& key) {
+    const OptionInfo& info = option_info(key);
+    if (info.glsl_define.empty()) throw std::logic_error("option '" + key + "' selects no shader code");
+    return info;
+}
+} // namespace
+
+std::map<std::string, std::string> glsl_defines(const std::map<std::string, std::string>& selections) {
+    std::map<std::string, std::string> defs;
+    for (const auto& info : option_catalog()) {
+        if (info.glsl_define.empty()) continue;
+        auto choices = info.choices();
+        for (size_t i = 0; i < choices.size(); ++i) defs[glsl_value_name(info, choices[i])] = std::to_string(i);
+    }
+    for (const auto& [key, value] : selections) {
+        const OptionInfo& info = shader_option(key);
+        defs[info.glsl_define] = std::to_string(index_in_table(info, value));
+    }
+    return defs;
+}
+
+std::map<std::string, std::string> shader_selections(const OptionMap& o, const std::string& method) {
+    std::map<std::string, std::string> out;
+    for (const auto& info : option_catalog())
+        if (!info.glsl_define.empty() && info.read_by(method)) out[info.key] = option_choice(o, info.key);
+    return out;
+}
+
+std::map<std::string, std::string> glsl_selection_names(const std::map<std::string, std::string>& selections) {
+    std::map<std::string, std::string> out;
+    for (const auto& [key, value] : selections) {
+        const OptionInfo& info = shader_option(key);
+        index_in_table(info, value);
+        out[info.glsl_define] = glsl_value_name(info, value);
+    }
+    return out;
+}
+
+} // namespace iblcheck

@@ -1,0 +1,60 @@
+// The one option table: every `--set key=value` a method reads, with its default, its values, the
+// methods that read it and, for variants that select shader code, the GLSL define. Everything
+// else derives from it: `iblcheck list`, validation of suites and command lines, the host's
+// reading of enumerated options and the defines the shaders are compiled with.
+//
+// Adding a variant is one row here (or one more name in a row's values) plus its shader code:
+// an enumerated option with a define compiles every shader with the selection as an index
+// (MIP_MAPPING 2) and every value's name as a named constant (MIP_MAPPING_UE4 0,
+// MIP_MAPPING_FILAMENT 1, MIP_MAPPING_ORIGIN 2), so GLSL reads `#if MIP_MAPPING == MIP_MAPPING_ORIGIN`.
+// Shaders have no fallback of their own: a missing define is a compile error, never a silent
+// default that could disagree with the table.
+#pragma once
+#include <map>
+#include <string>
+#include <vector>
+
+#include "harness/common/options.h"
+
+namespace iblcheck {
+
+struct OptionInfo {
+    std::string key;
+    std::string default_value;
+    std::string values;      // "ue4|filament|origin" for an enumeration; else a range or a description
+    std::string methods;     // "mobile", "mobile,sampled", "all"
+    std::string glsl_define; // enumerations that select shader code; empty otherwise
+    std::string description;
+
+    bool enumerated() const { return values.find('|') != std::string::npos; }
+    std::vector<std::string> choices() const; // the values of an enumeration, default first
+    bool read_by(const std::string& method) const;
+};
+
+// The table, in the order `iblcheck list` prints it.
+const std::vector<OptionInfo>& option_catalog();
+
+// The row for `key`; throws std::logic_error for a key not in the table (a programming error:
+// user input is checked by validate_spec() before any renderer reads it).
+const OptionInfo& option_info(const std::string& key);
+
+// The value of enumerated option `key` in `o`, or the table's default; UsageError naming the key
+// and the valid values for anything else.
+std::string option_choice(const OptionMap& o, const std::string& key);
+
+// "MIP_MAPPING_ORIGIN": the GLSL name of one value of an option with a define.
+std::string glsl_value_name(const OptionInfo& info, const std::string& value);
+
+// The defines a shader is compiled with: the named values of every option with a define, plus,
+// for each (key, value) in `selections`, DEFINE = the value's index. Throws UsageError for a value
+// not in the table.
+std::map<std::string, std::string> glsl_defines(const std::map<std::string, std::string>& selections);
+
+// For every option with a define that `method` reads: key -> the value in `o` (or the default).
+std::map<std::string, std::string> shader_selections(const OptionMap& o, const std::string& method);
+
+// The selections alone as DEFINE = value name (e.g. "STORAGE": "STORAGE_RGBA16F"): what the
+// results record as the shader variant.
+std::map<std::string, std::string> glsl_selection_names(const std::map<std::string, std::string>& selections);
+
+} // namespace iblcheck
