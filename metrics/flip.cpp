@@ -62,8 +62,10 @@ inline float clamp01(float v) { return std::min(std::max(v, 0.0f), 1.0f); }
 
 // Hot kernels, compiled for AVX2 and for baseline x86-64 and picked at load time. The results are
 // identical either way: no FMA contraction (-ffp-contract=off), only correctly rounded IEEE
-// operations, same order per element.
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+// operations, same order per element. Not under ASan/TSan: the clones' ifunc resolver runs while
+// the dynamic linker relocates, before the sanitizer runtime is initialised, and crashes there.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_THREAD__) && \
+    !defined(__SANITIZE_ADDRESS__)
 #define IBLCHECK_SIMD_CLONES __attribute__((target_clones("avx2", "default")))
 #else
 #define IBLCHECK_SIMD_CLONES
@@ -390,7 +392,9 @@ FlipResult compute_flip_hdr(const cv::Mat& ref_linear, const cv::Mat& test_linea
     r.stop_exposure = stop;
     r.num_exposures = num;
 
-    r.errmap = cv::Mat::zeros(h, w, CV_32F);
+    // Not cv::Mat::zeros: its MatExpr goes through a lazily built OpenCV singleton that TSan sees
+    // racing between the runner's workers.
+    r.errmap = cv::Mat(h, w, CV_32F, cv::Scalar(0));
     FlipEngine engine(w, h, ppd, opts.threads);
     const cv::Mat* imgs[2] = {&ref_linear, &test_linear};
     const float step = (stop - start) / float(num - 1);

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# Installs everything iblcheck needs from Debian's packages (and the report's charting library from
-# npm). Idempotent: installs only what is missing. Safe to run on every invocation of the README's
-# commands; when nothing is missing it takes about a second.
+# Installs everything iblcheck needs from Debian's packages (the report needs no front-end
+# package: its page is plain HTML/SVG/JS written by reports/). Idempotent: installs only what is
+# missing. Safe to run on every invocation of the README's commands; when nothing is missing it
+# takes about a second.
 set -euo pipefail
 
 PACKAGES=(
@@ -12,6 +13,7 @@ PACKAGES=(
   libopencv-dev libopencv-contrib-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   nlohmann-json3-dev libcli11-dev libfmt-dev
+  clang-format clang-tidy
   xz-utils
 )
 # Optional: the report's browser test runs where chromium is present; set IBLCHECK_NO_CHROMIUM=1 to skip it.

@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
-# README command 2 (and .ci/run): set-up, build, then every test through CTest.
+# README command 2 (and .ci/run): set-up, build, every test through CTest, then the sanitizer runs
+# (scripts/sanitize.sh: ASan+UBSan unit tests, TSan over the runner; IBLCHECK_NO_SANITIZERS=1
+# skips them).
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 bash "$root/scripts/build.sh"
-cd "$root/build"
-ctest --output-on-failure -j"$(nproc)" "$@"
+(cd "$root/build" && ctest --output-on-failure -j"$(nproc)" "$@")
+bash "$root/scripts/sanitize.sh"

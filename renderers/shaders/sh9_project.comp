@@ -7,6 +7,7 @@
 // reads from the 1×1 mip.
 // One workgroup; the reduction order is fixed, so the result is bit-identical run to run.
 #include "common.glsl"
+#include "sh9.glsl"
 
 layout(local_size_x = 256) in;
 layout(binding = 0, rgba32f) uniform readonly image2DArray source;
@@ -15,18 +16,6 @@ layout(push_constant) uniform Push { uint size; } pc;
 
 shared vec3 partial[256][9];
 shared float partial_w[256];
-
-void sh9_basis(vec3 d, out float y[9]) {
-    y[0] = 0.282095;
-    y[1] = 0.488603 * d.y;
-    y[2] = 0.488603 * d.z;
-    y[3] = 0.488603 * d.x;
-    y[4] = 1.092548 * d.x * d.y;
-    y[5] = 1.092548 * d.y * d.z;
-    y[6] = 0.315392 * (3.0 * d.z * d.z - 1.0);
-    y[7] = 1.092548 * d.x * d.z;
-    y[8] = 0.546274 * (d.x * d.x - d.y * d.y);
-}
 
 void main() {
     uint lid = gl_LocalInvocationID.x;
@@ -62,6 +51,6 @@ void main() {
         const float a_hat[9] = float[9](PI, 2.0 * PI / 3.0, 2.0 * PI / 3.0, 2.0 * PI / 3.0,
                                         PI / 4.0, PI / 4.0, PI / 4.0, PI / 4.0, PI / 4.0);
         for (int k = 0; k < 9; ++k) sh.coeffs[k] = vec4(partial[0][k] * norm * a_hat[k] / PI, 0.0);
-        sh.coeffs[9] = vec4(partial[0][0] * norm * 0.282095, 0.0);
+        sh.coeffs[9] = vec4(partial[0][0] * norm * SH_Y00, 0.0);
     }
 }

@@ -200,11 +200,14 @@ Context::Context(const ContextOptions& options) {
         info_.device_id = chosen->props.deviceID;
         info_.timestamp_period_ns = chosen->props.limits.timestampPeriod;
         info_.validation = validation;
+        // Compiled once: the runner's workers create contexts concurrently, and compiling a
+        // std::regex races on libstdc++'s ctype cache (found by TSan, issue 15).
+        static const std::regex mesa_re(R"(Mesa ([0-9][0-9.]*[0-9](-[a-z0-9]+)?))");
+        static const std::regex llvm_re(R"(LLVM ([0-9][0-9.]*[0-9]))");
         std::smatch m;
-        if (std::regex_search(info_.driver_info, m, std::regex(R"(Mesa ([0-9][0-9.]*[0-9](-[a-z0-9]+)?))")))
-            info_.mesa_version = m[1];
+        if (std::regex_search(info_.driver_info, m, mesa_re)) info_.mesa_version = m[1];
         std::string both = info_.driver_info + " " + info_.device_name;
-        if (std::regex_search(both, m, std::regex(R"(LLVM ([0-9][0-9.]*[0-9]))"))) info_.llvm_version = m[1];
+        if (std::regex_search(both, m, llvm_re)) info_.llvm_version = m[1];
 
         // Queue family with compute.
         uint32_t nq = 0;
