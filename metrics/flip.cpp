@@ -1,12 +1,14 @@
 // FLIP evaluation engine. The arithmetic of each pixel follows the reference tool (float32, same
-// operation order, taps summed from -r to +r); the structure is ours: two passes per LDR
-// evaluation over planar row buffers,
-//   H pass: input row -> linear RGB -> YCxCz -> 7 horizontally filtered planes per image
-//           (4 CSF planes: Y, Cx, Cz part 1, Cz part 2; 3 feature planes: G', G'', G on Y),
-//   V pass: vertical filtering of those planes in x-tiles, then colour error, feature error and
-//           the final FLIP value per pixel (and the running max over exposures for HDR).
-// Tap loops run with the tap index outermost and x innermost, so each pixel still accumulates its
-// taps in order -r..r (same rounding as the tool) while the compiler vectorises across x.
+// operation order, taps summed from -r to +r); the structure is ours. The image is cut into strips
+// of 256 columns; per strip, two passes stream down the rows:
+//   H pass: input row -> linear RGB -> YCxCz -> 7 horizontally filtered rows per image
+//           (4 CSF planes: Y, Cx, Cz part 1, Cz part 2; 3 feature planes: G', G'', G on Y), kept in
+//           a ring of the last 2r+1 rows (no full-image planes: they cost ~120 MB of page faults
+//           and memory traffic at 1080p),
+//   V pass: vertical filtering of those rows, then colour error, feature error and the final FLIP
+//           value per pixel (and the running max over exposures for HDR).
+// The loops themselves are in flip/kernels.h (scalar, SSE2 and AVX2 builds, identical results).
+// Threads take whole strips, so results do not depend on the thread count.
 #include "metrics/flip.h"
 
 #include <algorithm>
@@ -15,12 +17,13 @@
 #include <limits>
 #include <cstring>
 #include <stdexcept>
+#include <thread>
 #include <vector>
 
 #include "harness/common/errors.h"
 #include "metrics/flip/color_spaces.h"
 #include "metrics/flip/csf_filters.h"
-#include "metrics/flip/fast_math.h"
+#include "metrics/flip/kernels.h"
 #include "metrics/flip/feature_detection.h"
 #include "metrics/flip/magma_table.h"
 #include "metrics/flip/parallel.h"
@@ -30,9 +33,6 @@ namespace iblcheck {
 namespace {
 
 using namespace flip;
-
-// Plane indices of the H pass, per image.
-enum Plane { kPY = 0, kPCx, kPCz1, kPCz2, kPDx, kPDdx, kPG, kNumPlanes };
 
 // 8-bit sRGB -> linear lookup: PNG inputs hold exactly k/255, for which the table equals the
 // tool's per-pixel powf. Any other value falls back to the formula.
@@ -60,229 +60,164 @@ const SrgbLut& srgb_lut() {
 
 inline float clamp01(float v) { return std::min(std::max(v, 0.0f), 1.0f); }
 
-// Hot kernels, compiled for AVX2 and for baseline x86-64 and picked at load time. The results are
-// identical either way: no FMA contraction (-ffp-contract=off), only correctly rounded IEEE
-// operations, same order per element. Not under ASan/TSan: the clones' ifunc resolver runs while
-// the dynamic linker relocates, before the sanitizer runtime is initialised, and crashes there.
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_THREAD__) && \
-    !defined(__SANITIZE_ADDRESS__)
-#define IBLCHECK_SIMD_CLONES __attribute__((target_clones("avx2", "default")))
-#else
-#define IBLCHECK_SIMD_CLONES
-#endif
+// Plane indices of the H pass, per image.
+enum Plane { kPY = 0, kPCx, kPCz1, kPCz2, kPDx, kPDdx, kPG, kNumPlanes };
 
-// acc[x] = sum_k taps[k] * src[k][x], k ascending (the tool's tap order). For the horizontal
-// pass src[k] = row + k; for the vertical pass src[k] is the clamped row y + k - r.
-// Register-blocked over 16 / 8 pixels (GCC vector extension; two SSE halves on the baseline
-// clone, one AVX register on the AVX2 clone) so the accumulators never round-trip through memory.
-typedef float v8f __attribute__((vector_size(32)));
-__attribute__((always_inline)) inline v8f load8(const float* p) {
-    v8f v;
-    std::memcpy(&v, p, sizeof v);
-    return v;
-}
-__attribute__((always_inline)) inline void store8(float* p, v8f v) { std::memcpy(p, &v, sizeof v); }
-
-IBLCHECK_SIMD_CLONES
-void fir_accumulate(const float* const* src, const float* taps, int ntaps, int n, float* __restrict acc) {
-    int x = 0;
-    for (; x + 16 <= n; x += 16) {
-        const v8f t0 = v8f{} + taps[0];
-        v8f a = v8f{} + t0 * load8(src[0] + x);
-        v8f b = v8f{} + t0 * load8(src[0] + x + 8);
-        for (int k = 1; k < ntaps; ++k) {
-            const v8f t = v8f{} + taps[k];
-            a += t * load8(src[k] + x);
-            b += t * load8(src[k] + x + 8);
-        }
-        store8(acc + x, a);
-        store8(acc + x + 8, b);
-    }
-    for (; x + 8 <= n; x += 8) {
-        v8f a = v8f{} + (v8f{} + taps[0]) * load8(src[0] + x);
-        for (int k = 1; k < ntaps; ++k) a += (v8f{} + taps[k]) * load8(src[k] + x);
-        store8(acc + x, a);
-    }
-    for (; x < n; ++x) {
-        float a = 0.0f + taps[0] * src[0][x];
-        for (int k = 1; k < ntaps; ++k) a += taps[k] * src[k][x];
-        acc[x] = a;
-    }
-}
-
-// Linear RGB row -> YCxCz (padded output, offset by `pad`) and normalised Y for features.
-IBLCHECK_SIMD_CLONES
-void rgb_row_to_ycxcz(const float* __restrict R, const float* __restrict G, const float* __restrict B,
-                      int n, float* __restrict Y, float* __restrict Cx, float* __restrict Cz) {
-    for (int x = 0; x < n; ++x) {
-        float X, Yy, Z;
-        linear_rgb_to_xyz(R[x], G[x], B[x], X, Yy, Z);
-        xyz_to_ycxcz(X, Yy, Z, Y[x], Cx[x], Cz[x]);
-    }
-}
-
-inline float lab_f_fast(float t) {
-    constexpr float delta = 6.0f / 29.0f;
-    constexpr float delta_cube = delta * delta * delta;
-    constexpr float factor = 1.0f / (3.0f * delta * delta);
-    constexpr float term = 4.0f / 29.0f;
-    const float c = fast_cbrt(t > delta_cube ? t : delta_cube);
-    return t > delta_cube ? c : factor * t + term;
-}
-
-// Filtered YCxCz may leave the gamut: clamp in linear RGB, then CIELab with Hunt (Eq. 4).
-inline void to_hunt_lab(float Y, float Cx, float Cz, float& L, float& a, float& b) {
-    float X, Yy, Z, r, g, bl;
-    ycxcz_to_xyz(Y, Cx, Cz, X, Yy, Z);
-    xyz_to_linear_rgb(X, Yy, Z, r, g, bl);
-    r = std::min(std::max(r, 0.0f), 1.0f);
-    g = std::min(std::max(g, 0.0f), 1.0f);
-    bl = std::min(std::max(bl, 0.0f), 1.0f);
-    linear_rgb_to_xyz(r, g, bl, X, Yy, Z);
-    const float fx = lab_f_fast(X * kInvD65[0]);
-    const float fy = lab_f_fast(Yy * kInvD65[1]);
-    const float fz = lab_f_fast(Z * kInvD65[2]);
-    L = 116.0f * fy - 16.0f;
-    a = hunt(L, 500.0f * (fx - fy));
-    b = hunt(L, 200.0f * (fy - fz));
-}
-
-// Per-pixel FLIP from the vertically filtered planes. q[img * 8 + i], i: Y, Cx, Cz1, Cz2, dx,
-// ddx, dy, ddy.
-IBLCHECK_SIMD_CLONES
-void flip_pixels(const float* const* q, int n, float cmax, float pccmax, float* __restrict out) {
-    const float norm = 1.0f / std::sqrt(2.0f);
-#pragma GCC ivdep
-    for (int x = 0; x < n; ++x) {
-        // Colour difference (FLIP paper, Eqs. 4-7).
-        float Lr, ar, br, Lt, at, bt;
-        to_hunt_lab(q[0][x], q[1][x], q[2][x] + q[3][x], Lr, ar, br);
-        to_hunt_lab(q[8][x], q[9][x], q[10][x] + q[11][x], Lt, at, bt);
-        const float da = ar - at, db = br - bt;
-        const float dist = std::fabs(Lr - Lt) + std::sqrt(da * da + db * db);
-        const float c = fast_pow(dist, kQc);
-        // Eq. 7: [0, pc*cmax] -> [0, pt], [pc*cmax, cmax] -> [pt, 1].
-        const float cdiff = c < pccmax ? c * (kPt / pccmax)
-                                       : kPt + ((c - pccmax) / (cmax - pccmax)) * (1.0f - kPt);
-        // Feature difference (FLIP paper, Eq. 9).
-        const float dxr = q[4][x], ddxr = q[5][x], dyr = q[6][x], ddyr = q[7][x];
-        const float dxt = q[12][x], ddxt = q[13][x], dyt = q[14][x], ddyt = q[15][x];
-        const float edge = std::fabs(std::sqrt(dxr * dxr + dyr * dyr) - std::sqrt(dxt * dxt + dyt * dyt));
-        const float point = std::fabs(std::sqrt(ddxr * ddxr + ddyr * ddyr) - std::sqrt(ddxt * ddxt + ddyt * ddyt));
-        const float fdiff = std::sqrt(norm * (edge > point ? edge : point)); // ^qf, qf = 0.5
-        // Eq. 10: features sharpen the colour error towards 1.
-        out[x] = fast_pow(cdiff, 1.0f - fdiff);
-    }
-}
+// Columns per strip: the ring of horizontally filtered rows of one strip (2 images x 7 planes x
+// 2r+1 rows x 256 columns, ~300 KB at 67 ppd) stays in a core's L2 cache while the vertical pass
+// reads each row 2r+1 times.
+constexpr int kStripWidth = 256;
 
 class FlipEngine {
   public:
-    FlipEngine(int w, int h, float ppd, int threads)
-        : w_(w), h_(h), threads_(resolve_threads(threads)), sf_(make_spatial_filters(ppd)),
+    FlipEngine(int w, int h, float ppd, int threads, const Kernels& kernels)
+        : w_(w), h_(h), threads_(resolve_threads(threads)), k_(kernels), sf_(make_spatial_filters(ppd)),
           ff_(make_feature_filters(ppd)) {
         cmax_ = max_color_distance();
         pccmax_ = kPc * cmax_;
         pad_ = std::max(sf_.radius, ff_.radius);
-        for (auto& img : planes_)
-            for (auto& p : img) p.resize(size_t(w_) * h_);
+        depth_ = 2 * pad_ + 1;
+        plan_work();
     }
 
-    // One LDR-FLIP evaluation. prep(img, y, R, G, B) writes row y of image img (0 reference,
-    // 1 test) as linear RGB in [0,1]. With max_merge, out = max(out, FLIP) per pixel (HDR),
-    // otherwise out = FLIP.
+    // One LDR-FLIP evaluation. prep(img, y, x0, x1, R, G, B) writes columns [x0, x1) of row y of
+    // image img (0 reference, 1 test) as linear RGB in [0,1] (R[0] is column x0). With max_merge,
+    // out = max(out, FLIP) per pixel (HDR), otherwise out = FLIP.
     template <class Prep> void evaluate(const Prep& prep, float* out, bool max_merge) {
-        parallel_rows(h_, threads_, [&](int y0, int y1) { horizontal_pass(prep, y0, y1); });
-        parallel_rows(h_, threads_, [&](int y0, int y1) { vertical_pass(out, max_merge, y0, y1); });
+        const int workers = std::min(threads_, int(items_.size()));
+        auto work = [&](int t) {
+            Scratch s(*this);
+            for (size_t i = size_t(t); i < items_.size(); i += size_t(workers))
+                run_item(prep, items_[i], s, out, max_merge);
+        };
+        if (workers <= 1) {
+            work(0);
+            return;
+        }
+        std::vector<std::thread> pool;
+        for (int t = 1; t < workers; ++t) pool.emplace_back(work, t);
+        work(0);
+        for (auto& th : pool) th.join();
     }
 
   private:
-    template <class Prep> void horizontal_pass(const Prep& prep, int y0, int y1) {
-        const int pw = w_ + 2 * pad_;
-        std::vector<float> R(w_), G(w_), B(w_);
-        std::vector<float> Y(pw), Cx(pw), Cz(pw), Yn(pw);
-        std::vector<const float*> src(2 * pad_ + 1);
-        for (int img = 0; img < 2; ++img) {
-            auto& P = planes_[img];
-            for (int y = y0; y < y1; ++y) {
-                prep(img, y, R.data(), G.data(), B.data());
-                rgb_row_to_ycxcz(R.data(), G.data(), B.data(), w_, Y.data() + pad_, Cx.data() + pad_,
-                                 Cz.data() + pad_);
-                // Clamp-to-edge borders, as the tool clamps the tap coordinate.
-                for (int i = 0; i < pad_; ++i) {
-                    Y[i] = Y[pad_], Cx[i] = Cx[pad_], Cz[i] = Cz[pad_];
-                    Y[pad_ + w_ + i] = Y[pad_ + w_ - 1];
-                    Cx[pad_ + w_ + i] = Cx[pad_ + w_ - 1];
-                    Cz[pad_ + w_ + i] = Cz[pad_ + w_ - 1];
-                }
-                // Feature detection runs on Y normalised to [0,1] (FLIP paper, Sec. 4.2).
-                const float one_over_116 = 1.0f / 116.0f, sixteen_over_116 = 16.0f / 116.0f;
-                for (int i = 0; i < pw; ++i) Yn[i] = Y[i] * one_over_116 + sixteen_over_116;
+    // A rectangle of output pixels computed by one thread: a strip of columns, all rows unless
+    // there are fewer strips than threads (then row bands; each band recomputes r rows above and
+    // below itself, which gives the same values).
+    struct Item {
+        int x0, x1, y0, y1;
+    };
 
-                const size_t row = size_t(y) * w_;
-                auto run = [&](const std::vector<float>& in, int radius, const std::vector<float>& taps,
-                               Plane plane) {
-                    const float* base = in.data() + (pad_ - radius);
-                    for (size_t k = 0; k < taps.size(); ++k) src[k] = base + k;
-                    fir_accumulate(src.data(), taps.data(), int(taps.size()), w_, P[plane].data() + row);
-                };
-                run(Y, sf_.radius, sf_.y, kPY);
-                run(Cx, sf_.radius, sf_.cx, kPCx);
-                run(Cz, sf_.radius, sf_.cz1, kPCz1);
-                run(Cz, sf_.radius, sf_.cz2, kPCz2);
-                run(Yn, ff_.radius, ff_.dg, kPDx);
-                run(Yn, ff_.radius, ff_.ddg, kPDdx);
-                run(Yn, ff_.radius, ff_.g, kPG);
+    // Per-thread buffers, reused across the items a thread computes.
+    struct Scratch {
+        std::vector<float> rgb, ycc, ring, vacc;
+        explicit Scratch(const FlipEngine& e) {
+            const size_t pw = size_t(e.strip_ + 2 * e.pad_);
+            rgb.resize(3 * pw);
+            ycc.resize(4 * pw);
+            ring.resize(size_t(2) * kNumPlanes * e.depth_ * e.strip_);
+            vacc.resize(size_t(16) * e.strip_);
+        }
+    };
+
+    void plan_work() {
+        strip_ = std::min(kStripWidth, w_);
+        const int strips = (w_ + strip_ - 1) / strip_;
+        int bands = 1;
+        if (strips < threads_) bands = std::max(1, std::min((threads_ + strips - 1) / strips, h_ / 64));
+        const int band_h = (h_ + bands - 1) / bands;
+        for (int b = 0; b < bands; ++b)
+            for (int sx = 0; sx < strips; ++sx) {
+                const int y0 = b * band_h, y1 = std::min(h_, y0 + band_h);
+                if (y0 < y1) items_.push_back({sx * strip_, std::min(w_, (sx + 1) * strip_), y0, y1});
             }
+    }
+
+    float* ring_row(Scratch& s, int img, int plane, int y) const {
+        return s.ring.data() + ((size_t(img) * kNumPlanes + plane) * depth_ + size_t(y % depth_)) * strip_;
+    }
+
+    // Horizontal pass of row y, columns [x0, x1), both images: 7 filtered planes into the ring.
+    template <class Prep> void horizontal_row(const Prep& prep, const Item& it, int y, Scratch& s) const {
+        const int n = it.x1 - it.x0, pw = n + 2 * pad_;
+        const size_t stride = size_t(strip_ + 2 * pad_);
+        float *R = s.rgb.data(), *G = R + stride, *B = G + stride;
+        float *Y = s.ycc.data(), *Cx = Y + stride, *Cz = Cx + stride, *Yn = Cz + stride;
+        // Input columns x0 - pad .. x1 + pad, clamped to the image (the tool clamps tap coordinates).
+        const int xa = std::max(0, it.x0 - pad_), xb = std::min(w_, it.x1 + pad_);
+        const int lo = xa - (it.x0 - pad_), hi = lo + (xb - xa);
+        for (int img = 0; img < 2; ++img) {
+            prep(img, y, xa, xb, R + lo, G + lo, B + lo);
+            k_.rgb_to_ycxcz(R + lo, G + lo, B + lo, xb - xa, Y + lo, Cx + lo, Cz + lo, Yn + lo);
+            for (float* c : {Y, Cx, Cz, Yn}) {
+                for (int i = 0; i < lo; ++i) c[i] = c[lo];
+                for (int i = hi; i < pw; ++i) c[i] = c[hi - 1];
+            }
+            auto run = [&](const float* in, int radius, std::initializer_list<const std::vector<float>*> taps,
+                           std::initializer_list<Plane> planes) {
+                const float* src[64];
+                const float* tp[3];
+                float* dst[3];
+                const int ntaps = 2 * radius + 1;
+                for (int k = 0; k < ntaps; ++k) src[k] = in + (pad_ - radius) + k;
+                int f = 0;
+                for (const auto* t : taps) tp[f++] = t->data();
+                f = 0;
+                for (Plane p : planes) dst[f++] = ring_row(s, img, p, y);
+                k_.fir(src, tp, f, ntaps, n, dst);
+            };
+            run(Y, sf_.radius, {&sf_.y}, {kPY});
+            run(Cx, sf_.radius, {&sf_.cx}, {kPCx});
+            run(Cz, sf_.radius, {&sf_.cz1, &sf_.cz2}, {kPCz1, kPCz2});
+            run(Yn, ff_.radius, {&ff_.dg, &ff_.ddg, &ff_.g}, {kPDx, kPDdx, kPG});
         }
     }
 
-    void vertical_pass(float* out, bool max_merge, int y0, int y1) const {
-        constexpr int kTile = 512;
-        std::vector<float> acc(16 * kTile), err(kTile);
+    // Vertical pass of row y for the item's columns, then FLIP per pixel into out.
+    void vertical_row(const Item& it, int y, Scratch& s, float* out, bool max_merge) const {
+        const int n = it.x1 - it.x0;
         const float* q[16];
-        for (int i = 0; i < 16; ++i) q[i] = acc.data() + i * kTile;
-        std::vector<const float*> src(2 * pad_ + 1);
-        auto column = [&](const std::vector<float>& plane, const std::vector<float>& taps, int y,
-                          int x0, int n, int slot) {
-            const int r = int(taps.size()) / 2;
-            for (int k = 0; k < int(taps.size()); ++k) {
-                const int yy = std::min(std::max(y + k - r, 0), h_ - 1);
-                src[k] = plane.data() + size_t(yy) * w_ + x0;
-            }
-            fir_accumulate(src.data(), taps.data(), int(taps.size()), n, acc.data() + slot * kTile);
+        for (int i = 0; i < 16; ++i) q[i] = s.vacc.data() + size_t(i) * strip_;
+        auto column = [&](int img, Plane plane, std::initializer_list<const std::vector<float>*> taps,
+                          std::initializer_list<int> slots) {
+            const float* src[64];
+            const float* tp[3];
+            float* dst[3];
+            const int ntaps = int((*taps.begin())->size()), r = ntaps / 2;
+            for (int k = 0; k < ntaps; ++k) src[k] = ring_row(s, img, plane, std::min(std::max(y + k - r, 0), h_ - 1));
+            int f = 0;
+            for (const auto* t : taps) tp[f++] = t->data();
+            f = 0;
+            for (int slot : slots) dst[f++] = s.vacc.data() + size_t(img * 8 + slot) * strip_;
+            k_.fir(src, tp, f, ntaps, n, dst);
         };
-        for (int y = y0; y < y1; ++y) {
-            for (int x0 = 0; x0 < w_; x0 += kTile) {
-                const int n = std::min(kTile, w_ - x0);
-                for (int img = 0; img < 2; ++img) {
-                    const auto& P = planes_[img];
-                    const int s = img * 8;
-                    column(P[kPY], sf_.y, y, x0, n, s + 0);
-                    column(P[kPCx], sf_.cx, y, x0, n, s + 1);
-                    column(P[kPCz1], sf_.cz1, y, x0, n, s + 2);
-                    column(P[kPCz2], sf_.cz2, y, x0, n, s + 3);
-                    column(P[kPDx], ff_.g, y, x0, n, s + 4);  // d/dx: G'(x) G(y)
-                    column(P[kPDdx], ff_.g, y, x0, n, s + 5); // d2/dx2: G''(x) G(y)
-                    column(P[kPG], ff_.dg, y, x0, n, s + 6);  // d/dy: G(x) G'(y)
-                    column(P[kPG], ff_.ddg, y, x0, n, s + 7); // d2/dy2: G(x) G''(y)
-                }
-                flip_pixels(q, n, cmax_, pccmax_, err.data());
-                float* dst = out + size_t(y) * w_ + x0;
-                if (max_merge) {
-                    for (int x = 0; x < n; ++x) dst[x] = err[x] > dst[x] ? err[x] : dst[x];
-                } else {
-                    std::memcpy(dst, err.data(), sizeof(float) * n);
-                }
-            }
+        for (int img = 0; img < 2; ++img) {
+            column(img, kPY, {&sf_.y}, {0});
+            column(img, kPCx, {&sf_.cx}, {1});
+            column(img, kPCz1, {&sf_.cz1}, {2});
+            column(img, kPCz2, {&sf_.cz2}, {3});
+            column(img, kPDx, {&ff_.g}, {4});          // d/dx: G'(x) G(y)
+            column(img, kPDdx, {&ff_.g}, {5});         // d2/dx2: G''(x) G(y)
+            column(img, kPG, {&ff_.dg, &ff_.ddg}, {6, 7}); // d/dy: G(x) G'(y); d2/dy2: G(x) G''(y)
+        }
+        k_.flip_pixels(q, n, cmax_, pccmax_, out + size_t(y) * w_ + it.x0, max_merge);
+    }
+
+    template <class Prep> void run_item(const Prep& prep, const Item& it, Scratch& s, float* out, bool max_merge) const {
+        int next = std::max(0, it.y0 - pad_); // next row of the horizontal pass
+        for (int y = it.y0; y < it.y1; ++y) {
+            for (const int last = std::min(h_ - 1, y + pad_); next <= last; ++next) horizontal_row(prep, it, next, s);
+            vertical_row(it, y, s, out, max_merge);
         }
     }
 
     int w_, h_, threads_;
+    const Kernels& k_;
     SpatialFilters sf_;
     FeatureFilters ff_;
     float cmax_ = 0, pccmax_ = 0;
-    int pad_ = 0;
-    std::array<std::array<std::vector<float>, kNumPlanes>, 2> planes_;
+    int pad_ = 0, depth_ = 0, strip_ = 0;
+    std::vector<Item> items_;
 };
 
 void check_pair(const cv::Mat& a, const cv::Mat& b, const char* what) {
@@ -330,15 +265,15 @@ FlipResult compute_flip_ldr(const cv::Mat& ref_srgb, const cv::Mat& test_srgb, c
     r.mode = "ldr";
     r.ppd = ppd;
     r.errmap.create(h, w, CV_32F);
-    FlipEngine engine(w, h, ppd, opts.threads);
+    FlipEngine engine(w, h, ppd, opts.threads, opts.kernels ? *opts.kernels : default_kernels());
     const SrgbLut& lut = srgb_lut();
     const cv::Mat* imgs[2] = {&ref_srgb, &test_srgb};
-    auto prep = [&](int img, int y, float* R, float* G, float* B) {
-        const float* p = imgs[img]->ptr<float>(y);
-        for (int x = 0; x < w; ++x, p += 3) {
-            R[x] = clamp01(lut(p[0]));
-            G[x] = clamp01(lut(p[1]));
-            B[x] = clamp01(lut(p[2]));
+    auto prep = [&](int img, int y, int x0, int x1, float* R, float* G, float* B) {
+        const float* p = imgs[img]->ptr<float>(y) + 3 * x0;
+        for (int i = 0; i < x1 - x0; ++i, p += 3) {
+            R[i] = clamp01(lut(p[0]));
+            G[i] = clamp01(lut(p[1]));
+            B[i] = clamp01(lut(p[2]));
         }
     };
     engine.evaluate(prep, r.errmap.ptr<float>(), false);
@@ -395,21 +330,21 @@ FlipResult compute_flip_hdr(const cv::Mat& ref_linear, const cv::Mat& test_linea
     // Not cv::Mat::zeros: its MatExpr goes through a lazily built OpenCV singleton that TSan sees
     // racing between the runner's workers.
     r.errmap = cv::Mat(h, w, CV_32F, cv::Scalar(0));
-    FlipEngine engine(w, h, ppd, opts.threads);
+    FlipEngine engine(w, h, ppd, opts.threads, opts.kernels ? *opts.kernels : default_kernels());
     const cv::Mat* imgs[2] = {&ref_linear, &test_linear};
     const float step = (stop - start) / float(num - 1);
     const ToneMapper tm = opts.tone_mapper;
     for (int i = 0; i < num; ++i) {
         const float exposure = start + float(i) * step;
         const float m = std::pow(2.0f, exposure);
-        auto prep = [&](int img, int y, float* R, float* G, float* B) {
-            const float* p = imgs[img]->ptr<float>(y);
-            for (int x = 0; x < w; ++x, p += 3) {
+        auto prep = [&](int img, int y, int x0, int x1, float* R, float* G, float* B) {
+            const float* p = imgs[img]->ptr<float>(y) + 3 * x0;
+            for (int i = 0; i < x1 - x0; ++i, p += 3) {
                 float cr = p[0] * m, cg = p[1] * m, cb = p[2] * m;
                 tone_map(tm, cr, cg, cb);
-                R[x] = clamp01(cr);
-                G[x] = clamp01(cg);
-                B[x] = clamp01(cb);
+                R[i] = clamp01(cr);
+                G[i] = clamp01(cg);
+                B[i] = clamp01(cb);
             }
         };
         engine.evaluate(prep, r.errmap.ptr<float>(), true);

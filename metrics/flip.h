@@ -21,6 +21,10 @@
 
 namespace iblcheck {
 
+namespace flip {
+struct Kernels;
+}
+
 struct FlipOptions {
     double ppd = double(flip::kDefaultPpd); // pixels per degree of visual angle (67.0206451)
     flip::ToneMapper tone_mapper = flip::ToneMapper::aces;
@@ -28,6 +32,7 @@ struct FlipOptions {
     std::optional<float> stop_exposure;
     std::optional<int> num_exposures;       // HDR: max(2, ceil(stop - start)) when absent
     int threads = 0;                        // 0: std::thread::hardware_concurrency()
+    const flip::Kernels* kernels = nullptr; // nullptr: flip::default_kernels() (flip/kernels.h)
 };
 
 struct FlipResult {

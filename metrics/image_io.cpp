@@ -1,45 +1,58 @@
 #include "metrics/image_io.h"
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <memory>
 #include <vector>
 
-#include <OpenImageIO/imageio.h>
 #include <fmt/format.h>
 
 #include "harness/common/errors.h"
+#include "metrics/image_formats.h"
 
 namespace iblcheck {
 
-namespace {
-bool is_hdr_format(const OIIO::ImageSpec& spec, const std::string& format_name) {
-    if (format_name == "openexr" || format_name == "hdr") return true;
-    return spec.format.basetype == OIIO::TypeDesc::HALF ||
-           spec.format.basetype == OIIO::TypeDesc::FLOAT ||
-           spec.format.basetype == OIIO::TypeDesc::DOUBLE;
+namespace imagefile {
+Format sniff_format(const std::string& path) {
+    unsigned char magic[8] = {};
+    if (FILE* f = std::fopen(path.c_str(), "rb")) {
+        const size_t n = std::fread(magic, 1, sizeof magic, f);
+        std::fclose(f);
+        static const unsigned char kExr[4] = {0x76, 0x2f, 0x31, 0x01};
+        static const unsigned char kPng[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+        if (n >= 4 && std::memcmp(magic, kExr, 4) == 0) return Format::exr;
+        if (n >= 8 && std::memcmp(magic, kPng, 8) == 0) return Format::png;
+    }
+    return Format::other;
 }
-} // namespace
 
-LoadedImage read_image(const std::string& path) {
+RawImage read_raw(const std::string& path, bool unassociated_alpha) {
     std::error_code ec;
-    if (!std::filesystem::exists(path, ec))
-        throw InputError(fmt::format("{}: file not found", path));
+    if (!std::filesystem::exists(path, ec)) throw InputError(fmt::format("{}: file not found", path));
     if (std::filesystem::is_directory(path, ec))
         throw InputError(fmt::format("{}: is a directory, not an image", path));
-    // OpenImageIO premultiplies colour by alpha on read unless told the file's alpha is
-    // unassociated, which PNG's is by definition: read the colour as stored.
-    OIIO::ImageSpec config;
-    config.attribute("oiio:UnassociatedAlpha", 1);
-    auto in = OIIO::ImageInput::open(path, &config);
-    if (!in) {
-        std::string why = OIIO::geterror();
-        throw InputError(fmt::format("{}: cannot read image ({})", path,
-                                     why.empty() ? "unknown format or corrupt file" : why));
+    switch (sniff_format(path)) {
+    case Format::exr:
+        if (std::optional<RawImage> img = read_exr(path)) return std::move(*img);
+        break; // a channel layout OpenImageIO orders its own way
+    case Format::png:
+        return read_png(path);
+    case Format::other:
+        break;
     }
-    const OIIO::ImageSpec spec = in->spec();
-    const int nch = spec.nchannels;
-    if (spec.width <= 0 || spec.height <= 0)
+    return read_with_oiio(path, unassociated_alpha);
+}
+} // namespace imagefile
+
+LoadedImage read_image(const std::string& path) {
+    // PNG's alpha is unassociated by definition: the colour is read as stored.
+    imagefile::RawImage raw = imagefile::read_raw(path, true);
+    const int nch = raw.channels;
+    if (raw.width <= 0 || raw.height <= 0)
         throw InputError(fmt::format("{}: image has no pixels", path));
     if (nch < 1 || nch > 4)
         throw InputError(fmt::format("{}: unsupported channel count {} (expected 1-4)", path, nch));
@@ -47,36 +60,14 @@ LoadedImage read_image(const std::string& path) {
     LoadedImage li;
     li.path = path;
     li.file_channels = nch;
-    li.hdr = is_hdr_format(spec, in->format_name());
-    const size_t npix = size_t(spec.width) * spec.height;
-    std::vector<float> data(npix * nch);
-    bool ok;
-    if (li.hdr) {
-        ok = in->read_image(0, 0, 0, nch, OIIO::TypeDesc::FLOAT, data.data());
-    } else if (spec.format.basetype == OIIO::TypeDesc::UINT8) {
-        // Divide by 255 ourselves so values are exactly k/255.0f (matches the FLIP tool).
-        std::vector<unsigned char> raw(npix * nch);
-        ok = in->read_image(0, 0, 0, nch, OIIO::TypeDesc::UINT8, raw.data());
-        for (size_t i = 0; i < raw.size(); ++i) data[i] = float(raw[i]) / 255.0f;
-    } else {
-        std::vector<unsigned short> raw(npix * nch);
-        ok = in->read_image(0, 0, 0, nch, OIIO::TypeDesc::UINT16, raw.data());
-        for (size_t i = 0; i < raw.size(); ++i) data[i] = float(raw[i]) / 65535.0f;
-    }
-    if (!ok) {
-        std::string why = in->geterror();
-        throw InputError(fmt::format("{}: corrupt or truncated image data ({})", path,
-                                     why.empty() ? "read failed" : why));
-    }
-    in->close();
-
+    li.hdr = raw.hdr;
     // Grey (+alpha) -> RGB; RGBA -> RGB.
-    li.pixels.create(spec.height, spec.width, CV_32FC3);
+    li.pixels.create(raw.height, raw.width, CV_32FC3);
     const bool grey = nch <= 2;
-    for (int y = 0; y < spec.height; ++y) {
+    for (int y = 0; y < raw.height; ++y) {
         float* dst = li.pixels.ptr<float>(y);
-        const float* src = data.data() + size_t(y) * spec.width * nch;
-        for (int x = 0; x < spec.width; ++x, src += nch, dst += 3) {
+        const float* src = raw.data.data() + size_t(y) * raw.width * nch;
+        for (int x = 0; x < raw.width; ++x, src += nch, dst += 3) {
             if (grey) {
                 dst[0] = dst[1] = dst[2] = src[0];
             } else {
@@ -88,17 +79,10 @@ LoadedImage read_image(const std::string& path) {
 }
 
 namespace {
-void write_with_oiio(const std::string& path, const cv::Mat& mat, OIIO::TypeDesc type,
-                     const void* data) {
-    const int nch = mat.channels();
-    auto out = OIIO::ImageOutput::create(path);
-    if (!out) throw InputError(fmt::format("{}: cannot create image writer ({})", path, OIIO::geterror()));
-    OIIO::ImageSpec spec(mat.cols, mat.rows, nch, type);
-    if (!out->open(path, spec))
-        throw InputError(fmt::format("{}: cannot open for writing ({})", path, out->geterror()));
-    if (!out->write_image(type, data))
-        throw InputError(fmt::format("{}: write failed ({})", path, out->geterror()));
-    out->close();
+std::string lower_extension(const std::string& path) {
+    std::string e = std::filesystem::path(path).extension().string();
+    for (auto& c : e) c = char(std::tolower((unsigned char)c));
+    return e;
 }
 } // namespace
 
@@ -106,7 +90,11 @@ void write_exr(const std::string& path, const cv::Mat& mat) {
     if (mat.depth() != CV_32F || (mat.channels() != 1 && mat.channels() != 3))
         throw InputError(fmt::format("{}: write_exr needs a 1- or 3-channel float image", path));
     cv::Mat c = mat.isContinuous() ? mat : mat.clone();
-    write_with_oiio(path, c, OIIO::TypeDesc::FLOAT, c.ptr<float>());
+    // The format follows the file name, as it did when OpenImageIO chose the writer.
+    if (lower_extension(path) == ".exr")
+        imagefile::write_exr(path, c.cols, c.rows, c.channels(), c.ptr<float>());
+    else
+        imagefile::write_with_oiio(path, c.cols, c.rows, c.channels(), true, c.ptr<float>());
 }
 
 void write_png(const std::string& path, const cv::Mat& mat) {
@@ -121,7 +109,10 @@ void write_png(const std::string& path, const cv::Mat& mat) {
             bytes[i++] = (unsigned char)(v * 255.0f + 0.5f);
         }
     }
-    write_with_oiio(path, mat, OIIO::TypeDesc::UINT8, bytes.data());
+    if (lower_extension(path) == ".png")
+        imagefile::write_png(path, mat.cols, mat.rows, mat.channels(), bytes.data());
+    else
+        imagefile::write_with_oiio(path, mat.cols, mat.rows, mat.channels(), false, bytes.data());
 }
 
 NonFinite find_non_finite(const cv::Mat& mat) {

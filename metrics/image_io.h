@@ -1,4 +1,5 @@
-// Image files at the edges of the harness (OpenImageIO). In memory every image is a cv::Mat,
+// Image files at the edges of the harness: OpenEXR and PNG through their own libraries, other
+// formats through OpenImageIO, loaded only when such a file is read (image_formats.h). In memory every image is a cv::Mat,
 // CV_32FC3 in RGB order (not OpenCV's BGR): linear radiance for HDR files (EXR, Radiance HDR,
 // float TIFF), sRGB-encoded values in [0,1] for 8/16-bit files (PNG, JPEG...).
 // Bad input throws iblcheck::InputError whose message starts with the file path.

@@ -397,6 +397,85 @@ TEST_F(CompareCommand, IdenticalImagesPerfectScores) {
     EXPECT_TRUE(j["psnr"]["db"].is_null()); // +inf
 }
 
+TEST(ComparePairsList, ParsesLines) {
+    EXPECT_EQ(parse_pair_line("").kind, PairLine::Kind::blank);
+    EXPECT_EQ(parse_pair_line("   # ref test").kind, PairLine::Kind::blank);
+    PairLine p = parse_pair_line("  a.png   b.png \r");
+    ASSERT_EQ(p.kind, PairLine::Kind::pair);
+    EXPECT_EQ(p.reference, "a.png");
+    EXPECT_EQ(p.test, "b.png");
+    p = parse_pair_line("my renders/a.png\tmy renders/b.png");
+    ASSERT_EQ(p.kind, PairLine::Kind::pair);
+    EXPECT_EQ(p.reference, "my renders/a.png");
+    EXPECT_EQ(p.test, "my renders/b.png");
+    p = parse_pair_line("a.png b.png c.png");
+    EXPECT_EQ(p.kind, PairLine::Kind::bad);
+    EXPECT_EQ(p.problem, "expected 2 paths (REF TEST), found 3");
+    EXPECT_EQ(parse_pair_line("only.png").kind, PairLine::Kind::bad);
+}
+
+TEST_F(CompareCommand, PairsGiveOneJsonLinePerPairWithTheSingleCompareValues) {
+    write_png(path("a.png"), synthetic(40, 32, 1, 0.02f));
+    write_png(path("b.png"), synthetic(40, 32, 2, 0.05f));
+    write_exr(path("a.exr"), synthetic(40, 32, 3, 0.0f) * 3.0);
+    write_exr(path("b.exr"), synthetic(40, 32, 4, 0.1f) * 3.0);
+    std::istringstream list(path("a.png") + " " + path("b.png") + "\n" + path("a.exr") + " " + path("b.exr") + "\n");
+    CompareArgs all;
+    ASSERT_EQ(run_compare_pairs(all, list, "list.txt", out_, err_), 0) << err_.str();
+    std::vector<nlohmann::json> lines;
+    std::istringstream ss(out_.str());
+    for (std::string l; std::getline(ss, l);) lines.push_back(nlohmann::json::parse(l));
+    ASSERT_EQ(lines.size(), 2u);
+    EXPECT_NE(err_.str().find("compared 2 pair(s)"), std::string::npos) << err_.str();
+    // Each line holds what `compare --json` prints for that pair alone, plus where it came from.
+    for (size_t i = 0; i < 2; ++i) {
+        const std::string ref = lines[i]["reference"], test = lines[i]["test"];
+        CompareArgs one = args(ref, test);
+        one.json = true;
+        std::ostringstream o, e;
+        ASSERT_EQ(run_compare(one, o, e), 0) << e.str();
+        nlohmann::json single = nlohmann::json::parse(o.str());
+        nlohmann::json batched = lines[i];
+        EXPECT_EQ(batched["line"], int(i) + 1);
+        batched.erase("reference"), batched.erase("test"), batched.erase("line");
+        EXPECT_EQ(batched, single) << ref;
+    }
+    EXPECT_EQ(lines[1]["flip"]["mode"], "hdr");
+}
+
+TEST_F(CompareCommand, PairsReportEveryFailureAndExit2) {
+    write_png(path("a.png"), synthetic(16, 16, 1, 0));
+    write_png(path("small.png"), synthetic(8, 8, 1, 0));
+    std::istringstream list(path("a.png") + " " + path("nope.png") + "\n" + "one-path-only\n" + path("a.png") + " " +
+                            path("small.png") + "\n" + path("a.png") + " " + path("a.png") + "\n");
+    CompareArgs c;
+    c.metric = "psnr";
+    EXPECT_EQ(run_compare_pairs(c, list, "pairs.txt", out_, err_), kExitError);
+    std::vector<nlohmann::json> lines;
+    std::istringstream ss(out_.str());
+    for (std::string l; std::getline(ss, l);) lines.push_back(nlohmann::json::parse(l));
+    ASSERT_EQ(lines.size(), 4u) << out_.str();
+    EXPECT_EQ(lines[0]["error"], path("nope.png") + ": file not found");
+    EXPECT_EQ(lines[1]["error"], "pairs.txt: line 2: expected 2 paths (REF TEST), found 1");
+    EXPECT_NE(lines[2]["error"].get<std::string>().find(path("small.png") + ": size 8x8 does not match"),
+              std::string::npos) << lines[2];
+    EXPECT_TRUE(lines[3]["psnr"]["db"].is_null()); // identical: the good pair is still compared
+    EXPECT_NE(err_.str().find("compared 1 pair(s), 3 could not be compared"), std::string::npos) << err_.str();
+}
+
+TEST_F(CompareCommand, PairsRefusePerPairOutputsAndBadOptionsBeforeReading) {
+    std::istringstream list("a.png b.png\n");
+    CompareArgs c;
+    c.heatmap = path("h.png");
+    EXPECT_EQ(run_compare_pairs(c, list, "l", out_, err_), kExitError);
+    EXPECT_NE(err_.str().find("not with --pairs"), std::string::npos) << err_.str();
+    EXPECT_EQ(out_.str(), "");
+    CompareArgs bad;
+    bad.metric = "lpips";
+    EXPECT_EQ(run_compare_pairs(bad, list, "l", out_, err_), kExitError);
+    EXPECT_NE(err_.str().find("--metric"), std::string::npos);
+}
+
 } // namespace
 
 // Writes an 8-bit RGBA PNG (OpenImageIO, unassociated alpha as PNG stores it).

@@ -6,11 +6,13 @@
 
 #include "commands.h"
 #include "compare_command.h"
+#include "harness/cli/version.h"
 #include "harness/common/errors.h"
 
 int main(int argc, char** argv) {
     CLI::App app{"iblcheck — image-diff validation harness for mobile IBL shaders"};
     app.require_subcommand(1);
+    app.set_version_flag("--version", iblcheck::cli::version_string(), "Print the version, commit, compiler and build type");
     int exit_code = iblcheck::kExitPass;
     iblcheck::cli::register_doctor_command(app, exit_code);
     iblcheck::cli::register_list_command(app, exit_code);

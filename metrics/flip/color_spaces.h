@@ -6,6 +6,7 @@
 #pragma once
 #include <cmath>
 
+#include "metrics/flip/fast_math.h"
 #include "metrics/flip/flip_constants.h"
 
 namespace iblcheck::flip {
@@ -21,7 +22,7 @@ inline float linear_to_srgb(float c) {
 }
 
 // Linear sRGB primaries -> CIE XYZ, D65, exact rational coefficients (the tool's matrix).
-inline void linear_rgb_to_xyz(float r, float g, float b, float& x, float& y, float& z) {
+IBLCHECK_FLIP_INLINE void linear_rgb_to_xyz(float r, float g, float b, float& x, float& y, float& z) {
     constexpr float a11 = 10135552.0f / 24577794.0f, a12 = 8788810.0f / 24577794.0f,
                     a13 = 4435075.0f / 24577794.0f;
     constexpr float a21 = 2613072.0f / 12288897.0f, a22 = 8788810.0f / 12288897.0f,
@@ -33,14 +34,14 @@ inline void linear_rgb_to_xyz(float r, float g, float b, float& x, float& y, flo
     z = a31 * r + a32 * g + a33 * b;
 }
 
-inline void xyz_to_linear_rgb(float x, float y, float z, float& r, float& g, float& b) {
+IBLCHECK_FLIP_INLINE void xyz_to_linear_rgb(float x, float y, float z, float& r, float& g, float& b) {
     r = 3.241003275f * x + -1.537398934f * y + -0.498615861f * z;
     g = -0.969224334f * x + 1.875930071f * y + 0.041554224f * z;
     b = 0.055639423f * x + -0.204011202f * y + 1.057148933f * z;
 }
 
 // YCxCz: the linear (no cube root) variant of CIELab (FLIP paper, Sec. 4.1).
-inline void xyz_to_ycxcz(float x, float y, float z, float& Y, float& Cx, float& Cz) {
+IBLCHECK_FLIP_INLINE void xyz_to_ycxcz(float x, float y, float z, float& Y, float& Cx, float& Cz) {
     x *= kInvD65[0];
     y *= kInvD65[1];
     z *= kInvD65[2];
@@ -48,7 +49,7 @@ inline void xyz_to_ycxcz(float x, float y, float z, float& Y, float& Cx, float& 
     Cx = 500.0f * (x - y);
     Cz = 200.0f * (y - z);
 }
-inline void ycxcz_to_xyz(float Y, float Cx, float Cz, float& x, float& y, float& z) {
+IBLCHECK_FLIP_INLINE void ycxcz_to_xyz(float Y, float Cx, float Cz, float& x, float& y, float& z) {
     const float yy = (Y + 16.0f) / 116.0f;
     const float cx = Cx / 500.0f;
     const float cz = Cz / 200.0f;
@@ -75,7 +76,7 @@ inline void xyz_to_lab(float x, float y, float z, float& L, float& a, float& b) 
 }
 
 // Hunt effect (FLIP paper, Eq. 4): chroma scales with luminance, so dark colours differ less.
-inline float hunt(float L, float chroma) { return 0.01f * L * chroma; }
+IBLCHECK_FLIP_INLINE float hunt(float L, float chroma) { return 0.01f * L * chroma; }
 
 // HyAB distance (FLIP paper, Eq. 5): city-block on L, Euclidean on (a, b).
 inline float hyab(float L1, float a1, float b1, float L2, float a2, float b2) {

@@ -7,10 +7,14 @@
 #include <bit>
 #include <cstdint>
 
+// Always inlined: the FLIP kernels are compiled once per instruction set (flip/kernels.h), and an
+// out-of-line copy of a helper compiled for AVX2 could be the one the linker keeps for every caller.
+#define IBLCHECK_FLIP_INLINE inline __attribute__((always_inline))
+
 namespace iblcheck::flip {
 
 // Cube root for x >= 0: exponent/3 bit estimate, then Newton y <- y - (y^3 - x) / (3 y^2).
-inline float fast_cbrt(float x) {
+IBLCHECK_FLIP_INLINE float fast_cbrt(float x) {
     const uint32_t bits = std::bit_cast<uint32_t>(x);
     float y = std::bit_cast<float>(bits / 3u + 709921077u); // ~6% initial error
     y = y - (y * y * y - x) / (3.0f * y * y);
@@ -22,7 +26,7 @@ inline float fast_cbrt(float x) {
 
 // log2 for x > 0 (normal floats): x = m 2^e, m in [sqrt(1/2), sqrt(2)),
 // ln m = 2 atanh(t), t = (m - 1) / (m + 1), |t| <= 0.1716, series to t^9.
-inline float fast_log2(float x) {
+IBLCHECK_FLIP_INLINE float fast_log2(float x) {
     const int32_t bits = std::bit_cast<int32_t>(x);
     // Re-bias so the mantissa lands in [sqrt(1/2), sqrt(2)).
     const int32_t off = bits - 0x3f3504f3;
@@ -35,7 +39,7 @@ inline float fast_log2(float x) {
 }
 
 // 2^y for y in about [-126, 127]: 2^round(y) by bits, 2^f (|f| <= 0.5) by Taylor to degree 7.
-inline float fast_exp2(float y) {
+IBLCHECK_FLIP_INLINE float fast_exp2(float y) {
     y = y < -126.0f ? -126.0f : (y > 127.0f ? 127.0f : y);
     const float n = float(int32_t(y + (y >= 0.0f ? 0.5f : -0.5f)));
     const float f = (y - n) * 0.693147180559945309f;
@@ -45,7 +49,7 @@ inline float fast_exp2(float y) {
 }
 
 // x^p for x >= 0, p >= 0, with pow's conventions 0^0 = 1 and 0^p = 0 (p > 0).
-inline float fast_pow(float x, float p) {
+IBLCHECK_FLIP_INLINE float fast_pow(float x, float p) {
     const float tiny = x > 1e-30f ? 0.0f : 1.0f;           // arithmetic masks keep the loop
     const float r = fast_exp2(p * fast_log2(x + tiny));     // branch-free (vectorises under AVX2)
     const float zero_value = p == 0.0f ? 1.0f : 0.0f;

@@ -1,8 +1,6 @@
 // Environment loading and the equirect convention (environment.h).
 #include "renderers/environments/environment.h"
 
-#include <OpenImageIO/imageio.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -12,6 +10,7 @@
 
 #include "harness/common/errors.h"
 #include "harness/common/options.h"
+#include "metrics/image_formats.h"
 #include "renderers/environments/procedural.h"
 
 namespace iblcheck {
@@ -65,15 +64,18 @@ Environment load_file(const std::string& spec, const std::string& path) {
     env.spec = spec;
     env.source_path = path;
     if (!std::filesystem::exists(path)) throw InputError("environment file '" + path + "' does not exist");
-    auto in = OIIO::ImageInput::open(path);
-    if (!in) throw InputError("environment file '" + path + "': cannot open: " + OIIO::geterror());
-    const OIIO::ImageSpec& s = in->spec();
-    int w = s.width, h = s.height, nch = s.nchannels;
+    imagefile::RawImage img;
+    try {
+        img = imagefile::read_raw(path, false);
+    } catch (const InputError& e) {
+        // read_raw's message starts with the path; say which environment it was.
+        std::string why = e.what();
+        if (why.rfind(path + ": ", 0) == 0) why = why.substr(path.size() + 2);
+        throw InputError("environment file '" + path + "': " + why);
+    }
+    const int w = img.width, h = img.height, nch = img.channels;
     if (w <= 0 || h <= 0 || nch <= 0) throw InputError("environment file '" + path + "': empty image");
-    std::vector<float> buf(size_t(w) * h * nch);
-    if (!in->read_image(0, 0, 0, nch, OIIO::TypeDesc::FLOAT, buf.data()))
-        throw InputError("environment file '" + path + "': cannot read pixels: " + in->geterror());
-    in->close();
+    const std::vector<float>& buf = img.data;
     env.equirect.create(h, w, CV_32FC3);
     long bad = 0;
     std::string first_bad;

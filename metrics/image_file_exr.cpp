@@ -1,0 +1,99 @@
+// OpenEXR files through the OpenEXR library itself (image_formats.h).
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfInputFile.h>
+#include <ImfOutputFile.h>
+
+#include <exception>
+#include <memory>
+
+#include <fmt/format.h>
+
+#include "harness/common/errors.h"
+#include "metrics/image_formats.h"
+
+namespace iblcheck::imagefile {
+
+namespace {
+// OpenEXR reports problems as exceptions (Iex); the harness's messages name the file first.
+std::unique_ptr<Imf::InputFile> open_exr(const std::string& path) {
+    try {
+        return std::make_unique<Imf::InputFile>(path.c_str());
+    } catch (const std::exception& e) {
+        throw InputError(fmt::format("{}: cannot read image ({})", path, e.what()));
+    }
+}
+} // namespace
+
+std::optional<RawImage> read_exr(const std::string& path) {
+    const std::unique_ptr<Imf::InputFile> file = open_exr(path);
+    Imf::InputFile& in = *file;
+    try {
+        const Imf::Header& h = in.header();
+        const Imath::Box2i dw = h.dataWindow();
+        const Imf::ChannelList& cl = h.channels();
+        std::vector<std::string> names;
+        for (auto it = cl.begin(); it != cl.end(); ++it) {
+            // Subsampled channels (luminance/chroma files) and integer channels: OpenImageIO's job.
+            if (it.channel().xSampling != 1 || it.channel().ySampling != 1 || it.channel().type == Imf::UINT)
+                return std::nullopt;
+            names.push_back(it.name());
+        }
+        // OpenEXR stores channel names sorted (B, G, R); the harness reads them as OpenImageIO
+        // orders them: R, G, B, then A; Y, then A.
+        std::vector<std::string> order;
+        auto has = [&](const char* n) { return cl.findChannel(n) != nullptr; };
+        if (names.size() == 3 && has("R") && has("G") && has("B")) order = {"R", "G", "B"};
+        else if (names.size() == 4 && has("R") && has("G") && has("B") && has("A")) order = {"R", "G", "B", "A"};
+        else if (names.size() == 1 && has("Y")) order = {"Y"};
+        else if (names.size() == 2 && has("Y") && has("A")) order = {"Y", "A"};
+        else return std::nullopt;
+
+        RawImage img;
+        img.width = dw.max.x - dw.min.x + 1;
+        img.height = dw.max.y - dw.min.y + 1;
+        img.channels = int(order.size());
+        img.hdr = true;
+        img.reader = "openexr";
+        if (img.width <= 0 || img.height <= 0) return img;
+        img.data.resize(size_t(img.width) * img.height * img.channels);
+        const size_t xs = sizeof(float) * img.channels, ys = xs * img.width;
+        Imf::FrameBuffer fb;
+        for (int c = 0; c < img.channels; ++c)
+            fb.insert(order[size_t(c)], Imf::Slice::Make(Imf::FLOAT, img.data.data() + c, dw, xs, ys));
+        in.setFrameBuffer(fb);
+        in.readPixels(dw.min.y, dw.max.y);
+        return img;
+    } catch (const std::exception& e) {
+        throw InputError(fmt::format("{}: corrupt or truncated image data ({})", path, e.what()));
+    }
+}
+
+void write_exr(const std::string& path, int width, int height, int channels, const float* data) {
+    static const char* const kRgb[] = {"R", "G", "B"};
+    static const char* const kY[] = {"Y"};
+    const char* const* names = channels == 1 ? kY : kRgb;
+    Imf::Header h(width, height);
+    h.compression() = Imf::ZIP_COMPRESSION;
+    for (int c = 0; c < channels; ++c) h.channels().insert(names[c], Imf::Channel(Imf::FLOAT));
+    std::unique_ptr<Imf::OutputFile> file;
+    try {
+        file = std::make_unique<Imf::OutputFile>(path.c_str(), h);
+    } catch (const std::exception& e) {
+        throw InputError(fmt::format("{}: cannot open for writing ({})", path, e.what()));
+    }
+    try {
+        Imf::OutputFile& out = *file;
+        Imf::FrameBuffer fb;
+        const size_t xs = sizeof(float) * channels, ys = xs * width;
+        for (int c = 0; c < channels; ++c)
+            fb.insert(names[c], Imf::Slice(Imf::FLOAT, (char*)(data + c), xs, ys));
+        out.setFrameBuffer(fb);
+        out.writePixels(height);
+    } catch (const std::exception& e) {
+        throw InputError(fmt::format("{}: write failed ({})", path, e.what()));
+    }
+}
+
+} // namespace iblcheck::imagefile

@@ -1,0 +1,117 @@
+// Loads libiblcheck_oiio.so (metrics/oiio_plugin/) on first use and calls it (image_formats.h).
+#include <dlfcn.h>
+
+#include <filesystem>
+#include <mutex>
+
+#include <fmt/format.h>
+
+#include "harness/common/errors.h"
+#include "metrics/image_formats.h"
+#include "metrics/oiio_plugin/oiio_plugin_abi.h"
+
+namespace iblcheck::imagefile {
+
+namespace {
+
+constexpr const char* kPluginName = "libiblcheck_oiio.so";
+
+struct Plugin {
+    IblcheckOiioReadFn read = nullptr;
+    IblcheckOiioWriteFn write = nullptr;
+    std::string problem; // why it could not be loaded
+};
+
+std::once_flag g_once;
+Plugin g_plugin;
+bool g_loaded = false;
+
+void load_plugin() {
+    std::string tried;
+    for (const std::string& path : oiio_plugin_candidates()) {
+        std::error_code ec;
+        if (!std::filesystem::exists(path, ec)) {
+            tried += (tried.empty() ? "" : ", ") + path;
+            continue;
+        }
+        // RTLD_LOCAL: OpenImageIO's own dependencies stay out of the global symbol namespace.
+        void* h = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
+        if (!h) {
+            g_plugin.problem = fmt::format("cannot load {}: {}", path, dlerror());
+            return;
+        }
+        g_plugin.read = reinterpret_cast<IblcheckOiioReadFn>(dlsym(h, IBLCHECK_OIIO_READ_SYMBOL));
+        g_plugin.write = reinterpret_cast<IblcheckOiioWriteFn>(dlsym(h, IBLCHECK_OIIO_WRITE_SYMBOL));
+        if (!g_plugin.read || !g_plugin.write) {
+            g_plugin.problem = fmt::format("{} lacks {}", path, IBLCHECK_OIIO_READ_SYMBOL);
+            return;
+        }
+        g_loaded = true;
+        return;
+    }
+    g_plugin.problem = fmt::format("{} not found (looked for {}); rebuild iblcheck", kPluginName, tried);
+}
+
+const Plugin& plugin(const std::string& path) {
+    std::call_once(g_once, load_plugin);
+    if (!g_loaded)
+        throw EnvironmentError(fmt::format("{}: this format is read through OpenImageIO, but {}", path,
+                                           g_plugin.problem));
+    return g_plugin;
+}
+
+float* alloc_into(void* ctx, size_t count) {
+    auto* v = static_cast<std::vector<float>*>(ctx);
+    v->resize(count);
+    return v->data();
+}
+
+} // namespace
+
+std::vector<std::string> oiio_plugin_candidates() {
+    std::vector<std::string> out;
+    std::error_code ec;
+    const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", ec);
+    if (!ec) out.push_back((self.parent_path() / kPluginName).string());
+#ifdef IBLCHECK_PLUGIN_DIR
+    const std::string built = (std::filesystem::path(IBLCHECK_PLUGIN_DIR) / kPluginName).string();
+    if (out.empty() || out.front() != built) out.push_back(built);
+#endif
+    return out;
+}
+
+bool oiio_plugin_loaded() { return g_loaded; }
+
+RawImage read_with_oiio(const std::string& path, bool unassociated_alpha) {
+    const Plugin& p = plugin(path);
+    RawImage img;
+    IblcheckOiioImage out{};
+    out.alloc = alloc_into;
+    out.ctx = &img.data;
+    const int rc = p.read(path.c_str(), unassociated_alpha ? 1 : 0, &out);
+    const std::string why = out.error;
+    if (rc == kOiioCannotOpen)
+        throw InputError(fmt::format("{}: cannot read image ({})", path,
+                                     why.empty() ? "unknown format or corrupt file" : why));
+    if (rc != kOiioOk)
+        throw InputError(fmt::format("{}: corrupt or truncated image data ({})", path,
+                                     why.empty() ? "read failed" : why));
+    img.width = out.width;
+    img.height = out.height;
+    img.channels = out.channels;
+    img.hdr = out.hdr != 0;
+    img.reader = "openimageio";
+    return img;
+}
+
+void write_with_oiio(const std::string& path, int width, int height, int channels, bool is_float,
+                     const void* data) {
+    const Plugin& p = plugin(path);
+    char error[1024] = "";
+    const int rc = p.write(path.c_str(), width, height, channels, is_float ? 1 : 0, data, error, sizeof error);
+    if (rc == kOiioCannotCreate) throw InputError(fmt::format("{}: cannot create image writer ({})", path, error));
+    if (rc == kOiioCannotOpen) throw InputError(fmt::format("{}: cannot open for writing ({})", path, error));
+    if (rc != kOiioOk) throw InputError(fmt::format("{}: write failed ({})", path, error));
+}
+
+} // namespace iblcheck::imagefile
