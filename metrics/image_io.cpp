@@ -88,15 +88,16 @@ LoadedImage read_image(const std::string& path) {
 }
 
 namespace {
-void write_with_oiio(const std::string& path, const cv::Mat& mat, OIIO::TypeDesc type,
-                     const void* data) {
+// `type`: the file's pixel type; `data_type`: the type of `data` (default: the same).
+void write_with_oiio(const std::string& path, const cv::Mat& mat, OIIO::TypeDesc type, const void* data,
+                     OIIO::TypeDesc data_type = OIIO::TypeDesc::UNKNOWN) {
     const int nch = mat.channels();
     auto out = OIIO::ImageOutput::create(path);
     if (!out) throw InputError(fmt::format("{}: cannot create image writer ({})", path, OIIO::geterror()));
     OIIO::ImageSpec spec(mat.cols, mat.rows, nch, type);
     if (!out->open(path, spec))
         throw InputError(fmt::format("{}: cannot open for writing ({})", path, out->geterror()));
-    if (!out->write_image(type, data))
+    if (!out->write_image(data_type == OIIO::TypeDesc::UNKNOWN ? type : data_type, data))
         throw InputError(fmt::format("{}: write failed ({})", path, out->geterror()));
     out->close();
 }
@@ -107,6 +108,14 @@ void write_exr(const std::string& path, const cv::Mat& mat) {
         throw InputError(fmt::format("{}: write_exr needs a 1- or 3-channel float image", path));
     cv::Mat c = mat.isContinuous() ? mat : mat.clone();
     write_with_oiio(path, c, OIIO::TypeDesc::FLOAT, c.ptr<float>());
+}
+
+void write_exr_half(const std::string& path, const cv::Mat& mat) {
+    if (mat.depth() != CV_32F || (mat.channels() != 1 && mat.channels() != 3))
+        throw InputError(fmt::format("{}: write_exr_half needs a 1- or 3-channel float image", path));
+    // Clamped before OpenEXR's conversion, which would turn values above 65504 into +Inf.
+    cv::Mat c = cv::min(cv::max(mat, -65504.0f), 65504.0f);
+    write_with_oiio(path, c, OIIO::TypeDesc::HALF, c.ptr<float>(), OIIO::TypeDesc::FLOAT);
 }
 
 void write_png(const std::string& path, const cv::Mat& mat) {
