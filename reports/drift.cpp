@@ -36,7 +36,7 @@ std::optional<Flag> accuracy_flag(const std::vector<std::optional<double>>& valu
             best = Flag{idx.back(), a, b,
                         fmt::format("{} over {} runs since {}", percent(a, b), idx.size(), commit(idx.front()))};
     }
-    if (best) best->text += fmt::format(" (noise floor {:.2g})", floor);
+    if (best) best->text += floor > 0 ? fmt::format(" (noise floor {:.2g})", floor) : std::string(" (no noise floor recorded)");
     return best;
 }
 
@@ -52,9 +52,12 @@ std::optional<Flag> timing_flag(const std::vector<std::optional<Spread>>& spread
             double lo = INFINITY, hi = -INFINITY;
             for (size_t k = seen.size() > window ? seen.size() - window : 0; k < seen.size(); ++k)
                 lo = std::min(lo, spreads[seen[k]]->lo), hi = std::max(hi, spreads[seen[k]]->hi);
+            // Outside the hull, and farther from it than the hull is wide: a new extreme of a noisy
+            // series (likely one run in n) is not a change.
             double move = 0, from = 0;
-            if (s.lo > hi) move = (s.median - hi) / hi, from = hi;
-            else if (s.hi < lo) move = (s.median - lo) / lo, from = lo;
+            const double width = hi - lo;
+            if (s.lo > hi && s.median - hi > width) move = (s.median - hi) / hi, from = hi;
+            else if (s.hi < lo && lo - s.median > width) move = (s.median - lo) / lo, from = lo;
             if (move != 0 && std::isfinite(move) && std::fabs(move) > std::fabs(best_move)) {
                 best_move = move;
                 const std::string c = i < commits.size() ? commits[i] : "run " + std::to_string(i + 1);

@@ -4,8 +4,9 @@
 //   classes) when the run has one, else the reference golden's own seed noise (mean FLIP between
 //   two reference renders). A fixed percentage missed a real +3 % drift and flagged noise;
 // - a wall time is flagged only when a run's measured range (the median and spread of its
-//   repeated timings) lies wholly outside everything the runs before it measured: a 2-5x spread
-//   between identical runs on a loaded machine is not a change.
+//   repeated timings) lies wholly outside everything the runs before it measured, and its median
+//   farther from that hull than the hull is wide: a 2-5x spread between identical runs on a loaded
+//   machine is not a change, nor is a new extreme of a noisy series.
 #pragma once
 #include <optional>
 #include <string>
@@ -31,8 +32,9 @@ struct Spread {
 };
 
 // `spreads`: one per run, oldest first. A run is flagged when its [lo, hi] lies outside the hull of
-// the (at most `window`) present runs before it, and at least two runs came before it; of the
-// flagged runs the one whose median moved most (relative to the hull) is returned.
+// the (at most `window`) present runs before it, its median is farther from the hull than the hull
+// is wide, and at least two runs came before it; of the flagged runs the one whose median moved
+// most (relative to the hull) is returned.
 std::optional<Flag> timing_flag(const std::vector<std::optional<Spread>>& spreads,
                                 const std::vector<std::string>& commits, size_t window = 10);
 

@@ -150,10 +150,12 @@ void comparison_html(std::string& o, const json& t, const json& cmp, size_t k, b
     auto out = std::back_inserter(o);
     const std::string kind = str(cmp, "kind"), cv = str(cmp, "verdict");
     fmt::format_to(out, "<div class=\"cmp\" data-cmp=\"{}\"{}>", k, shown ? "" : " hidden");
-    fmt::format_to(out, "<div class=\"cmp-head\">{} against <span class=\"mono\">{}</span>{}</div>\n",
-                   kind == "reference" ? "Accuracy: the render" : "The render",
-                   e(str(cmp, "golden")), str(cmp, "label").empty() ? "" : " (label " + e(str(cmp, "label")) + ")");
     const json& imgs = sub(cmp, "images");
+    const bool identical = !str(imgs, "test_exr").empty() && str(imgs, "test_exr") == str(imgs, "golden_exr");
+    fmt::format_to(out, "<div class=\"cmp-head\">{} against <span class=\"mono\">{}</span>{}{}</div>\n",
+                   kind == "reference" ? "Accuracy: the render" : "The render", e(str(cmp, "golden")),
+                   str(cmp, "label").empty() ? "" : " (label " + e(str(cmp, "label")) + ")",
+                   identical ? ": <b>bit-identical</b> (FLIP 0 everywhere)" : "");
     ViewerSpec vs;
     vs.test_png = str(imgs, "test");
     vs.golden_png = str(imgs, "golden");
@@ -427,12 +429,14 @@ void test_card(std::string& o, const json& t, size_t idx, PageContext& ctx, cons
     if (sub(t, "comparisons").is_array())
         for (const json& c : t["comparisons"])
             if (str(c, "kind") != "cost") cmps.push_back(&c);
-    size_t first = 0;
-    for (size_t k = 0; k < cmps.size(); ++k)
-        if (str(*cmps[k], "verdict") != "pass") {
-            first = k;
-            break;
-        }
+    // Shown first: the first comparison that did not pass; when all passed, the truth (a passing
+    // render is usually bit-identical to its baseline: nothing to see there).
+    size_t first = cmps.size();
+    for (size_t k = 0; k < cmps.size() && first == cmps.size(); ++k)
+        if (str(*cmps[k], "verdict") != "pass") first = k;
+    for (size_t k = 0; k < cmps.size() && first == cmps.size(); ++k)
+        if (str(*cmps[k], "kind") == "reference") first = k;
+    if (first == cmps.size()) first = 0;
     if (cmps.size() > 1) {
         o += "<div class=\"cmp-tabs\"><span class=\"meta\">compare with</span>";
         for (size_t k = 0; k < cmps.size(); ++k) {

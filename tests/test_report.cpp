@@ -400,6 +400,8 @@ TEST(Drift, TimingIsFlaggedOnlyOutsideItsMeasuredSpread) {
     EXPECT_NE(f->text.find("at e (outside the 5\u201314 measured before)"), std::string::npos) << f->text;
     // Two runs are needed before anything can be judged.
     EXPECT_FALSE(timing_flag({Spread{1, 1, 1}, Spread{9, 9, 9}}, c));
+    // Just outside a narrow hull is a new extreme, not a change: 14.5 is 0.5 beyond [5, 14] (9 wide).
+    EXPECT_FALSE(timing_flag({Spread{5, 6, 11}, Spread{6, 9, 14}, Spread{14.5, 15, 16}}, c));
     // Faster counts too.
     f = timing_flag({Spread{10, 11, 12}, Spread{10, 11, 13}, Spread{3, 3.5, 4}}, c);
     ASSERT_TRUE(f);
