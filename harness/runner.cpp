@@ -55,9 +55,10 @@ struct Artefacts {
     std::string shared_exr(const std::string& golden_rel, const cv::Mat& linear) const {
         const fs::path shared = dir.parent_path() / "_goldens";
         const std::string file = safe_file_name(golden_rel);
-        if (!fs::exists(shared / file)) {  // two workers may both write it: same pixels, atomic rename
+        if (!fs::exists(shared / file)) {  // two workers (or processes) may both write it: same pixels, atomic rename
             fs::create_directories(shared);
-            const fs::path tmp = shared / (file + fmt::format(".tmp{}.exr", std::hash<std::thread::id>{}(std::this_thread::get_id())));
+            const fs::path tmp = shared / (file + fmt::format(".tmp{}-{}.exr", ::getpid(),
+                                                               std::hash<std::thread::id>{}(std::this_thread::get_id())));
             write_exr_half(tmp.string(), linear);
             fs::rename(tmp, shared / file);
         }

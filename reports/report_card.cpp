@@ -47,10 +47,10 @@ json spheres_of(const json& t) {
 void viewer_html(std::string& o, PageContext& ctx, const json& t, const ViewerSpec& vs) {
     auto out = std::back_inserter(o);
     auto ti = ctx.data.image(vs.test_exr);
-    auto gi = ctx.data.image(vs.golden_exr);
-    auto ei = ctx.data.image(vs.error_exr);
-    auto ids = ctx.data.id_map(str(sub(t, "layout"), "id_map"), spheres_of(t));
+    auto gi = ti ? ctx.data.image(vs.golden_exr) : std::nullopt;
+    auto ei = ti ? ctx.data.image(vs.error_exr) : std::nullopt;
     const bool live = ti.has_value();
+    auto ids = live ? ctx.data.id_map(str(sub(t, "layout"), "id_map"), spheres_of(t)) : std::nullopt;
     std::string attrs;
     if (live) {
         attrs += fmt::format(" data-test=\"{}\"", ti->key);
@@ -86,6 +86,20 @@ void viewer_html(std::string& o, PageContext& ctx, const json& t, const ViewerSp
                            "</label>",
                            e(vs.tol_note), vs.tol);
         o += "</div>\n";
+    }
+    if (!live) {
+        // No float data (results without EXRs, e.g. from an older harness): the PNGs side by side.
+        o += "<div class=\"vbody\">";
+        fmt::format_to(out, "<figure>{}<figcaption>test</figcaption></figure>", img_tag(ctx.images, vs.test_png, "t", "test"));
+        if (has_golden)
+            fmt::format_to(out, "<figure>{}<figcaption>{}</figcaption></figure>",
+                           img_tag(ctx.images, vs.golden_png, "gold", vs.golden_name), e(vs.golden_name));
+        if (has_heat)
+            fmt::format_to(out, "<figure>{}<figcaption>FLIP per pixel (magma, 0&ndash;1){}</figcaption></figure>",
+                           img_tag(ctx.images, vs.heat_png, "heat", "FLIP heatmap"),
+                           vs.block_x ? fmt::format("; worst 16&times;16 block at ({},{})", *vs.block_x, *vs.block_y) : "");
+        o += "</div></div>\n";
+        return;
     }
     o += "<div class=\"vbody\"><div class=\"vmain\">";
     auto blk = [&] {

@@ -262,6 +262,27 @@ TEST(Report, SelfContainedImagesAndMissingOnes) {
     EXPECT_TRUE(fs::exists(f.results_dir / "images/t1/test.png"));
 }
 
+// Results without float data (an older harness): the viewer is the PNGs side by side, no controls.
+TEST(Report, ResultsWithoutEXRsShowThePNGs) {
+    auto& f = testutil::small_run();
+    json r = f.results;
+    for (json& t : r["tests"]) {
+        t.erase("image_exr");
+        for (json& c : t["comparisons"])
+            if (c.contains("images"))
+                for (const char* k : {"test_exr", "golden_exr", "error_exr"}) c["images"].erase(k);
+    }
+    const fs::path out = f.root / "no_exr";
+    report::write_report(r, f.results_dir, out);
+    const std::string html = slurp(out / "index.html");
+    EXPECT_EQ(html.find("data-test=\""), std::string::npos);
+    EXPECT_EQ(html.find("class=\"ev\""), std::string::npos) << "no exposure control without float data";
+    const std::string fail = section_of(html, "mobile.roughness_sweep.studio.dominant_dir=lagarde");
+    EXPECT_NE(fail.find("<img class=\"gold\" src=\"images/t2/baseline.png\""), std::string::npos) << fail.substr(0, 4000);
+    EXPECT_NE(fail.find("worst 16&times;16 block at (96,16)"), std::string::npos);
+    EXPECT_FALSE(fs::exists(out / "data"));
+}
+
 TEST(Report, MalformedResultsNameFileAndProblem) {
     auto& f = testutil::small_run();
     auto expect_error = [&](json r, const std::string& what) {
