@@ -69,6 +69,20 @@ json per_sphere_errors(const TestSpec& spec, const cv::Mat& errmap) {
     return out;
 }
 
+SphereLayout sphere_layout(const TestSpec& spec, int width, int height) {
+    Scene scene = build_scene(spec.scene, spec.options);
+    SphereLayout out;
+    if (scene.spheres.size() > 254) return out;  // does not fit the 8-bit map: no layout
+    out.ids = cv::Mat(height, width, CV_8U);
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x) out.ids.at<uchar>(y, x) = uchar(sphere_index(scene, width, height, x, y) + 1);
+    for (size_t i = 0; i < scene.spheres.size(); ++i)
+        out.spheres.push_back({{"label", sphere_label(scene, int(i))},
+                               {"roughness", scene.spheres[i].material.roughness},
+                               {"metallic", scene.spheres[i].material.metallic}});
+    return out;
+}
+
 std::string sphere_at(const TestSpec& spec, int width, int height, int x, int y) {
     Scene scene = build_scene(spec.scene, spec.options);
     int id = sphere_index(scene, width, height, x, y);

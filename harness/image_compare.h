@@ -18,6 +18,15 @@ nlohmann::json compare_images(const cv::Mat& golden, const cv::Mat& test, int fl
 // scene's sphere names.
 nlohmann::json per_sphere_errors(const TestSpec& spec, const cv::Mat& errmap);
 
+// Where each sphere lies in a render of `spec`, for the report's "what is under the pointer":
+// `ids` (CV_8U, width x height) holds 0 for the background and i + 1 for sphere i (at most 254
+// spheres); `spheres` lists {label, roughness, metallic} in that order.
+struct SphereLayout {
+    cv::Mat ids;
+    nlohmann::json spheres = nlohmann::json::array();
+};
+SphereLayout sphere_layout(const TestSpec& spec, int width, int height);
+
 // The sphere under pixel (x, y) of a render of `spec` ("metal r=0.3"), or "" for the background.
 std::string sphere_at(const TestSpec& spec, int width, int height, int x, int y);
 

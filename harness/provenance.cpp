@@ -35,4 +35,14 @@ std::string platform_difference(const json& golden, const json& render, const st
     return diff.empty() ? "" : "golden blessed on another platform: " + diff;
 }
 
+json baseline_facts(const json& golden) {
+    json out = json::object();
+    for (const char* k : {"commit", "date", "shader_tree_hash", "cpu_class", "label"})
+        if (golden.contains(k) && golden[k].is_string()) out[k] = golden[k];
+    const json driver = golden.value("driver", json::object());
+    if (driver.is_object() && driver.contains("driver_info") && driver["driver_info"].is_string())
+        out["driver_info"] = driver["driver_info"];
+    return out;
+}
+
 } // namespace iblcheck

@@ -22,6 +22,10 @@ nlohmann::json render_cost(const RenderResult& r);
 std::string platform_difference(const nlohmann::json& golden_provenance, const nlohmann::json& render_provenance,
                                 const std::string& this_cpu_class);
 
+// What the report's "changed since the baseline" compares, picked from a golden's sidecar:
+// {"commit", "date", "shader_tree_hash", "driver_info", "cpu_class", "label"} (keys it lacks are left out).
+nlohmann::json baseline_facts(const nlohmann::json& golden_provenance);
+
 // llvmpipe's CPU class on this machine (GALLIUM_OVERRIDE_CPU_CAPS and LP_NATIVE_VECTOR_WIDTH included).
 std::string this_cpu_class();
 

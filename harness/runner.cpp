@@ -22,6 +22,7 @@
 #include "metrics/image_io.h"
 #include "provenance.h"
 #include "reports/report_writer.h"
+#include "reports/verdict_text.h"
 #include "stability.h"
 #include "temporal_check.h"
 #include "verdict.h"
@@ -35,19 +36,54 @@ namespace iblcheck {
 namespace {
 
 // The image files of one test, under <out>/images/<test>/; results name them relative to <out>.
+// Each image a person looks at is written twice: a PNG through the display transform (what SSIM
+// measured) and a half-float EXR beside it, the linear data the report's exposure control, colour
+// scale and exceedance mask work on.
 struct Artefacts {
     fs::path dir;
     std::string rel;  // "images/<test>/"
     explicit operator bool() const { return !dir.empty(); }
-    std::string png(const std::string& name, const cv::Mat& linear) const {
+    static std::string exr(const std::string& png) { return png.substr(0, png.rfind('.')) + ".exr"; }
+    std::string png(const std::string& name, const cv::Mat& linear, bool with_exr = true) const {
         fs::create_directories(dir);
         write_png((dir / name).string(), display_transform(linear));
+        if (with_exr) write_exr_half((dir / exr(name)).string(), linear);
         return rel + name;
+    }
+    // A golden many tests compare with (a reference) as one half-float EXR per run under
+    // images/_goldens/ (the same pixels are not written again for every test): its path.
+    std::string shared_exr(const std::string& golden_rel, const cv::Mat& linear) const {
+        const fs::path shared = dir.parent_path() / "_goldens";
+        const std::string file = safe_file_name(golden_rel);
+        if (!fs::exists(shared / file)) {  // two workers (or processes) may both write it: same pixels, atomic rename
+            fs::create_directories(shared);
+            const fs::path tmp = shared / (file + fmt::format(".tmp{}-{}.exr", ::getpid(),
+                                                               std::hash<std::thread::id>{}(std::this_thread::get_id())));
+            write_exr_half(tmp.string(), linear);
+            fs::rename(tmp, shared / file);
+        }
+        return "images/_goldens/" + file;
     }
     std::string heatmap(const std::string& name, const cv::Mat& errmap) const {
         fs::create_directories(dir);
         write_png((dir / name).string(), magma_heatmap(errmap));
+        write_exr_half((dir / exr(name)).string(), errmap);
         return rel + name;
+    }
+    // A comparison's images: {test, golden, heatmap} PNGs and their EXRs (test_exr, golden_exr, error_exr).
+    static json images(const std::string& test, const std::string& golden, const std::string& heatmap) {
+        return {{"test", test}, {"golden", golden}, {"heatmap", heatmap},
+                {"test_exr", exr(test)}, {"golden_exr", exr(golden)}, {"error_exr", exr(heatmap)}};
+    }
+    // Which sphere is where (the report names the sphere under the pointer): an 8-bit id map.
+    json layout(const TestSpec& spec, int width, int height) const {
+        SphereLayout l = sphere_layout(spec, width, height);
+        if (l.ids.empty()) return nullptr;
+        fs::create_directories(dir);
+        cv::Mat ids;
+        l.ids.convertTo(ids, CV_32F, 1.0 / 255.0);
+        write_png((dir / "spheres.png").string(), ids);
+        return {{"id_map", rel + "spheres.png"}, {"spheres", l.spheres}};
     }
 };
 
@@ -76,12 +112,31 @@ void record_render(json& r, const RenderResult& rr) {
     r["provenance"] = rr.provenance;
 }
 
+// Per-frame time of `repeats` renders in all (the first one already recorded in r): wall times
+// vary 2-5x on a loaded machine, so the results keep every sample and report their median.
+void repeat_timings(json& r, const TestCase& tc, Worker& w, int repeats) {
+    if (repeats < 2) return;
+    std::vector<double> frame{r["frame_ms"].get<double>()};
+    for (int k = 1; k < repeats; ++k) {
+        double f = 0;
+        for (auto& p : w.renderer.render(tc.spec).timings) f += p.precompute ? 0 : p.ms;
+        frame.push_back(f);
+    }
+    std::sort(frame.begin(), frame.end());
+    const size_t n = frame.size();
+    r["frame_ms_samples"] = frame;
+    r["frame_ms"] = n % 2 ? frame[n / 2] : 0.5 * (frame[n / 2 - 1] + frame[n / 2]);
+}
+
 // Where the error concentrates, for a person: "worst 16x16 block at (160,16) on metal r=0.3 ...".
-std::string worst_block(const TestSpec& spec, const FlipResult& flip, int width, int height) {
+// Recorded on the comparison ({x, y, flip, sphere}); a failing comparison's message says it too.
+void note_worst_block(Comparison& c, const TestSpec& spec, const FlipResult& flip, int width, int height) {
     std::string sphere = sphere_at(spec, width, height, std::min(flip.block_x + 8, width - 1),
                                    std::min(flip.block_y + 8, height - 1));
-    return fmt::format("worst 16x16 block at ({},{}){} with mean FLIP {:.4g}", flip.block_x, flip.block_y,
-                       sphere.empty() ? "" : " on " + sphere, flip.block_max);
+    c.worst_block = {{"x", flip.block_x}, {"y", flip.block_y}, {"flip", flip.block_max}, {"sphere", sphere}};
+    if (c.verdict == Verdict::fail)
+        c.message += fmt::format("; worst 16x16 block at ({},{}){} with mean FLIP {:.4g}", flip.block_x, flip.block_y,
+                                 sphere.empty() ? "" : " on " + sphere, flip.block_max);
 }
 
 struct BaselineOutcome {
@@ -112,11 +167,15 @@ BaselineOutcome judge_against_baselines(const TestCase& tc, const cv::Mat& image
         } else {
             FlipResult flip;
             c = judge_baseline(compare_images(g.image, image, flip_threads, &flip), tc.baseline_tolerances);
-            if (c.verdict == Verdict::fail) c.message += "; " + worst_block(tc.spec, flip, image.cols, image.rows);
+            note_worst_block(c, tc.spec, flip, image.cols, image.rows);
             if (art) {
                 std::string tag = g.label.empty() ? "baseline" : "baseline@" + safe_file_name(g.label);
-                c.images = {{"test", art.rel + "test.png"}, {"golden", art.png(tag + ".png", g.image)},
-                            {"heatmap", art.heatmap(tag + "_flip.png", flip.errmap)}};
+                // A render bit-identical to its baseline (the usual pass) shares the test's EXR.
+                const bool same = g.image.type() == image.type() && g.image.isContinuous() && image.isContinuous() &&
+                                  std::memcmp(g.image.data, image.data, image.total() * image.elemSize()) == 0;
+                c.images = Artefacts::images(art.rel + "test.png", art.png(tag + ".png", g.image, !same),
+                                             art.heatmap(tag + "_flip.png", flip.errmap));
+                if (same) c.images["golden_exr"] = c.images["test_exr"];
             }
         }
         c.golden = store.relative(g.image_path);
@@ -158,19 +217,21 @@ Comparison judge_against_truth(const TestCase& tc, const cv::Mat& image, const G
     json metrics = compare_images(ref.image, image, flip_threads, &flip);
     Comparison c = judge_reference(metrics, approved_accuracy, tc.reference_band);
     c.golden = store.relative(ref.image_path);
-    if (c.verdict == Verdict::fail) c.message += "; " + worst_block(tc.spec, flip, image.cols, image.rows);
+    note_worst_block(c, tc.spec, flip, image.cols, image.rows);
     r["accuracy"] = {{"flip_mean", flip.mean}, {"ssim", metrics["ssim"]["mean"]}, {"golden", c.golden},
                      {"noise_floor", ref.provenance.value("noise_floor", json())}};
     if (json ps = per_sphere_errors(tc.spec, flip.errmap); !ps.is_null()) r["per_sphere"] = ps;
-    if (art)
-        c.images = {{"test", art.rel + "test.png"}, {"golden", art.png("reference.png", ref.image)},
-                    {"heatmap", art.heatmap("reference_flip.png", flip.errmap)}};
+    if (art) {
+        c.images = Artefacts::images(art.rel + "test.png", art.png("reference.png", ref.image, false),
+                                     art.heatmap("reference_flip.png", flip.errmap));
+        c.images["golden_exr"] = art.shared_exr(c.golden, ref.image);
+    }
     return c;
 }
 
 // One test: render, compare, decide. Never throws: every outcome becomes a verdict.
 json run_test(const TestCase& tc, Worker& w, const GoldenStore& store, const fs::path& out_dir, int flip_threads,
-              bool& shader_error) {
+              int timing_repeats, bool& shader_error) {
     json r = test_header(tc);
     Artefacts art;
     if (!out_dir.empty()) art = {out_dir / "images" / safe_file_name(tc.name), "images/" + safe_file_name(tc.name) + "/"};
@@ -186,13 +247,19 @@ json run_test(const TestCase& tc, Worker& w, const GoldenStore& store, const fs:
         RenderResult rr = w.renderer.render(tc.spec);
         image = rr.image;
         record_render(r, rr);
+        repeat_timings(r, tc, w, timing_repeats);
         if (NonFinite nf = find_non_finite(rr.image); nf.count) throw NonFiniteRender("render: " + nf.describe());
-        if (art) r["image"] = art.png("test.png", rr.image);
+        if (art) {
+            r["image"] = art.png("test.png", rr.image);
+            r["image_exr"] = Artefacts::exr(r["image"]);
+            r["layout"] = art.layout(tc.spec, rr.image.cols, rr.image.rows);
+        }
 
         BaselineOutcome base;
         if (tc.baseline) {
             base = judge_against_baselines(tc, rr.image, store, art, flip_threads);
             r["comparisons"].push_back(to_json(base.comparison));
+            if (!base.missing) r["comparisons"].back()["approved"] = baseline_facts(base.golden.provenance);
             add(base.comparison.verdict, base.missing ? base.comparison.message : base.comparison.message.empty() ? "" : "baseline: " + base.comparison.message);
             if (!base.missing) {
                 Comparison cost;
@@ -302,8 +369,7 @@ void print_test_line(const json& r, int n, size_t total, bool interactive) {
     const std::string v = r["verdict"].get<std::string>();
     fmt::print("{}[{:>3}/{}] {:<15} {}{}  ({:.1f} s)\n", interactive ? "\r" : "", n, total, v,
                r["name"].get<std::string>(), acc, r["wall_s"].get<double>());
-    if (v != "pass" && !r["message"].get<std::string>().empty()) fmt::print("          {}\n", r["message"].get<std::string>());
-    if (is_regression(parse_verdict(v))) fmt::print("          approve this result: {}\n", r["bless_command"].get<std::string>());
+    for (const std::string& line : verdict_details(r)) fmt::print("          {}\n", line);
     std::fflush(stdout);
 }
 
@@ -339,7 +405,7 @@ RunSummary run_suite(const RunOptions& o) {
             bool se = false;
             TestCase tc = tests[i];
             if (o.stability) tc.stability.enabled = true;
-            results[i] = run_test(tc, w, store, o.out_dir, flip_threads, se);
+            results[i] = run_test(tc, w, store, o.out_dir, flip_threads, suite.timing_repeats, se);
             if (se) shader_error = true;
             int n = ++done;
             if (!o.quiet) {
@@ -400,9 +466,7 @@ RunSummary run_suite(const RunOptions& o) {
         fmt::print("{} tests: {} pass, {} fail, {} improved, {} missing-golden, {} error  ({:.1f} s){}\n", tests.size(),
                    s.pass, s.fail, s.improved, s.missing, s.error, R["total_s"].get<double>(),
                    o.out_dir.empty() ? "" : "  report: " + (o.out_dir / "index.html").string());
-        if (s.fail + s.missing > 0)
-            fmt::print("approve every failing result (after looking at them): iblcheck bless --suite '{}' --filter '{}'\n",
-                       tests[0].suite_arg, o.filter.empty() ? "*" : o.filter);
+        if (std::string all = rebless_all_line(R["tests"], tests[0].suite_arg); !all.empty()) fmt::print("{}\n", all);
     }
     return s;
 }

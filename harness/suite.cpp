@@ -2,6 +2,8 @@
 
 #include <fnmatch.h>
 
+#include <cmath>
+
 #include <fstream>
 #include <set>
 
@@ -144,8 +146,17 @@ std::vector<std::string> suite_names() {
     return out;
 }
 
+// Several globs separated by '|' match a name when one of them does (the "approve all failures"
+// line names each failing test; test names never hold '|').
 bool glob_match(const std::string& pattern, const std::string& name) {
-    return pattern.empty() || fnmatch(pattern.c_str(), name.c_str(), 0) == 0;
+    if (pattern.empty()) return true;
+    for (size_t start = 0;;) {
+        const size_t end = pattern.find('|', start);
+        const std::string one = pattern.substr(start, end == std::string::npos ? std::string::npos : end - start);
+        if (fnmatch(one.c_str(), name.c_str(), 0) == 0) return true;
+        if (end == std::string::npos) return false;
+        start = end + 1;
+    }
 }
 
 Suite load_suite(const std::string& name_or_path) {
@@ -178,7 +189,7 @@ Suite load_suite(const std::string& name_or_path) {
 
     json defaults = root.value("defaults", json::object());
     c.keys(defaults, "defaults", {"env", "size", "jobs", "baseline_tolerances", "reference_band", "stability",
-                                  "max_cost_growth"});
+                                  "max_cost_growth", "timing_repeats"});
     double default_cost_growth = defaults.contains("max_cost_growth")
                                      ? c.num(defaults["max_cost_growth"], "defaults.max_cost_growth")
                                      : 0.25;
@@ -189,6 +200,11 @@ Suite load_suite(const std::string& name_or_path) {
     int dw = 0, dh = 0;
     if (defaults.contains("size")) parse_size(c, defaults["size"], "defaults.size", dw, dh);
     if (defaults.contains("jobs")) suite.jobs = int(c.num(defaults["jobs"], "defaults.jobs"));
+    if (defaults.contains("timing_repeats")) {
+        const double n = c.num(defaults["timing_repeats"], "defaults.timing_repeats");
+        if (!(n >= 1 && n <= 20 && n == std::floor(n))) c.fail("defaults.timing_repeats", "must be an integer in 1..20");
+        suite.timing_repeats = int(n);
+    }
     auto default_bounds = defaults.contains("baseline_tolerances")
                               ? c.bounds(defaults["baseline_tolerances"], "defaults.baseline_tolerances")
                               : std::map<std::string, Bound>{};

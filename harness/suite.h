@@ -6,7 +6,7 @@
 // Schema (keys marked * are required):
 // {
 //   "suite"*: "ci",  "description": "...",
-//   "defaults": { "env": "studio", "size": "WxH", "jobs": 2, "max_cost_growth": 0.25,
+//   "defaults": { "env": "studio", "size": "WxH", "jobs": 2, "max_cost_growth": 0.25, "timing_repeats": 1,
 //                 "baseline_tolerances": { METRIC: {"min": x, "max": y}, ... },
 //                 "reference_band": { METRIC: {"below": rel, "above": rel, "abs": a}, ... } },
 //   "tests"*: [ { "scene"*: "roughness_sweep", "method"*: "mobile",
@@ -27,6 +27,8 @@
 // time: [v·(1 − below) − abs, v·(1 + above) + abs]; under the band is `improved`, over it `fail`.
 // max_cost_growth bounds the growth of the render's deterministic cost per pixel (executed SPIR-V
 // instructions, texture fetches) over the cost recorded with the baseline (0.25: +25 %).
+// timing_repeats renders each test that many times in all (1..20): the results then hold the
+// per-frame time's median and range (wall times vary 2-5x on a loaded machine; never gated).
 #pragma once
 #include <filesystem>
 #include <map>
@@ -89,6 +91,7 @@ struct Suite {
     std::filesystem::path file;
     std::string arg;                 // the suite's name, or the absolute path it was loaded from
     int jobs = 2;
+    int timing_repeats = 1;          // renders per test whose frame times give a median and range
     std::vector<TestCase> tests;
 };
 
@@ -97,7 +100,8 @@ std::filesystem::path suite_dir();
 std::vector<std::string> suite_names();
 // `name_or_path`: a suite name in suite_dir() or a path to a .json file. Throws InputError.
 Suite load_suite(const std::string& name_or_path);
-// Glob with * and ? (fnmatch semantics on the whole name).
+// Glob with * and ? (fnmatch semantics on the whole name); several globs separated by '|' match
+// a name when one of them does.
 bool glob_match(const std::string& pattern, const std::string& name);
 // Keeps the tests of shard `index` of `count` (round robin over the suite order).
 std::vector<TestCase> select_tests(const Suite& suite, const std::string& filter, int shard_index, int shard_count);

@@ -197,6 +197,7 @@ json to_json(const Comparison& c) {
     for (const Check& k : c.checks) j["checks"].push_back(to_json(k));
     if (!c.message.empty()) j["message"] = c.message;
     if (!c.images.is_null()) j["images"] = c.images;
+    if (!c.worst_block.is_null()) j["worst_block"] = c.worst_block;
     return j;
 }
 

@@ -68,6 +68,7 @@ struct Comparison {
     Verdict verdict = Verdict::pass;
     std::string message;               // the failing checks, joined
     nlohmann::json images;             // report images (test/golden/heatmap), set by the runner
+    nlohmann::json worst_block;        // {x, y, flip, sphere}: the worst 16x16 block, set by the runner
 };
 
 // Every tolerance of a baseline comparison. Sizes must match: a size mismatch is a failed "size"

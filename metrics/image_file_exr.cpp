@@ -70,13 +70,13 @@ std::optional<RawImage> read_exr(const std::string& path) {
     }
 }
 
-void write_exr(const std::string& path, int width, int height, int channels, const float* data) {
+void write_exr(const std::string& path, int width, int height, int channels, const float* data, bool half) {
     static const char* const kRgb[] = {"R", "G", "B"};
     static const char* const kY[] = {"Y"};
     const char* const* names = channels == 1 ? kY : kRgb;
     Imf::Header h(width, height);
     h.compression() = Imf::ZIP_COMPRESSION;
-    for (int c = 0; c < channels; ++c) h.channels().insert(names[c], Imf::Channel(Imf::FLOAT));
+    for (int c = 0; c < channels; ++c) h.channels().insert(names[c], Imf::Channel(half ? Imf::HALF : Imf::FLOAT));
     std::unique_ptr<Imf::OutputFile> file;
     try {
         file = std::make_unique<Imf::OutputFile>(path.c_str(), h);

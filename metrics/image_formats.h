@@ -42,8 +42,9 @@ RawImage read_png(const std::string& path);
 // rather than multiplied by alpha. Throws InputError (also when the plugin cannot be loaded).
 RawImage read_with_oiio(const std::string& path, bool unassociated_alpha);
 
-// Float OpenEXR, ZIP compression, channels R,G,B (3) or Y (1), as OpenImageIO wrote them.
-void write_exr(const std::string& path, int width, int height, int channels, const float* data);
+// OpenEXR, ZIP compression, channels R,G,B (3) or Y (1), as OpenImageIO wrote them; stored as float,
+// or as half (`half`: OpenEXR converts, values beyond ±65504 become ±Inf, so callers clamp first).
+void write_exr(const std::string& path, int width, int height, int channels, const float* data, bool half = false);
 // 8-bit PNG, RGB (3) or grey (1).
 void write_png(const std::string& path, int width, int height, int channels, const uint8_t* data);
 // Any format OpenImageIO chooses from the file name; data is float (is_float) or 8-bit.

@@ -97,6 +97,14 @@ void write_exr(const std::string& path, const cv::Mat& mat) {
         imagefile::write_with_oiio(path, c.cols, c.rows, c.channels(), true, c.ptr<float>());
 }
 
+void write_exr_half(const std::string& path, const cv::Mat& mat) {
+    if (mat.depth() != CV_32F || (mat.channels() != 1 && mat.channels() != 3))
+        throw InputError(fmt::format("{}: write_exr_half needs a 1- or 3-channel float image", path));
+    // Clamped before OpenEXR's conversion, which would turn values above 65504 into +Inf.
+    cv::Mat c = cv::min(cv::max(mat, -65504.0f), 65504.0f);
+    imagefile::write_exr(path, c.cols, c.rows, c.channels(), c.ptr<float>(), /*half=*/true);
+}
+
 void write_png(const std::string& path, const cv::Mat& mat) {
     if (mat.depth() != CV_32F || (mat.channels() != 1 && mat.channels() != 3))
         throw InputError(fmt::format("{}: write_png needs a 1- or 3-channel float image", path));

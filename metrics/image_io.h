@@ -25,6 +25,9 @@ LoadedImage read_image(const std::string& path);
 
 // Writes float data as EXR (half is not used: float keeps error maps exact). 1 or 3 channels.
 void write_exr(const std::string& path, const cv::Mat& mat);
+// Writes float data as half-float EXR (ZIP): a third of the size, for images people look at (the
+// report's exposure control); values above 65504 become 65504 (half's largest finite value).
+void write_exr_half(const std::string& path, const cv::Mat& mat);
 // Writes 8-bit PNG from float values in [0,1] (clamped, rounded), 1 or 3 channels, RGB order.
 void write_png(const std::string& path, const cv::Mat& mat);
 

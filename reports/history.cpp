@@ -1,4 +1,6 @@
 // The history file: JSON lines, one compact entry per run (reports/RESULTS_FORMAT.md, "History").
+#include <algorithm>
+#include <cmath>
 #include <fstream>
 
 #include <fmt/format.h>
@@ -52,6 +54,27 @@ json history_entry(const json& results) {
                 if (auto f = a->find("flip_mean"); f != a->end() && f->is_number()) x["flip_mean"] = *f;
             for (const char* k : {"frame_ms", "precompute_ms"})
                 if (auto v = t.find(k); v != t.end() && v->is_number()) x[k] = *v;
+            // The accuracy's noise floor (drift.h): measured by --stability, else the truth's own seed noise.
+            if (auto st = t.find("stability"); st != t.end() && st->is_object())
+                if (auto nf = st->find("noise_floor"); nf != st->end() && nf->is_object())
+                    if (auto f = nf->find("accuracy.flip.mean"); f != nf->end() && f->is_number()) x["flip_noise"] = *f;
+            if (!x.contains("flip_noise"))
+                if (auto a = t.find("accuracy"); a != t.end() && a->is_object())
+                    if (auto nf = a->find("noise_floor"); nf != a->end() && nf->is_object())
+                        if (auto f = nf->find("mean_flip"); f != nf->end() && f->is_number()) x["flip_noise"] = *f;
+            // The repeated timings' range (suite timing_repeats); frame_ms is their median.
+            if (auto sm = t.find("frame_ms_samples"); sm != t.end() && sm->is_array() && !sm->empty()) {
+                double lo = INFINITY, hi = -INFINITY;
+                for (const json& v : *sm)
+                    if (v.is_number()) lo = std::min(lo, v.get<double>()), hi = std::max(hi, v.get<double>());
+                if (std::isfinite(lo) && std::isfinite(hi)) {
+                    x["frame_ms_lo"] = lo;
+                    x["frame_ms_hi"] = hi;
+                    x["frame_n"] = sm->size();
+                }
+            }
+            if (auto c = t.find("cost"); c != t.end() && c->is_object())
+                if (auto i = c->find("spirv_instructions_per_pixel"); i != c->end() && i->is_number()) x["spirv_ipp"] = *i;
             if (auto tp = t.find("temporal"); tp != t.end() && tp->is_object())
                 if (auto f = tp->find("flicker"); f != tp->end() && f->is_number()) x["flicker"] = *f;
             tests[t["name"].get<std::string>()] = std::move(x);

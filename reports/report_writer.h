@@ -1,6 +1,10 @@
-// The HTML report (issue 8): one static index.html per run, in the style of Blender's render test
-// report. It opens from the file system (file://), offline: CSS, JS and SVG charts are inline and
-// every image it shows is copied next to it. Failures come first, with the command to rebless.
+// The HTML report (issues 8, 17): one static index.html per run, read in seconds: a summary (counts,
+// run facts, what changed since the baselines, the command that approves every failure), the
+// failures expanded with their images in a viewer (exposure on the float data, zoom, a magnifier on
+// the worst block, heatmaps with a colour scale and an exceedance mask, the sphere under the
+// pointer), the passing tests as a grid of thumbnails that open their card, and charts and history
+// on their own tabs. It opens from the file system (file://), offline: CSS, JS and SVG charts are
+// inline, every image it shows is copied next to it, and the float data is in data/*.js.
 // The input is the results JSON the harness writes (reports/RESULTS_FORMAT.md) and, optionally,
 // the history file (JSON lines, one compact entry per run) for the trend sparklines.
 #pragma once
@@ -33,8 +37,11 @@ void validate_results(const nlohmann::json& results, const std::string& source);
 std::vector<nlohmann::json> read_history(const std::filesystem::path& file);
 
 // The compact line a run appends:
-// {"commit","dirty","date","suite","tests":{NAME:{"verdict","flip_mean","frame_ms","precompute_ms","flicker"}}}
-// (flip_mean is accuracy vs the reference golden; numbers absent from the results are left out).
+// {"commit","dirty","date","suite","tests":{NAME:{"verdict","flip_mean","flip_noise","spirv_ipp","frame_ms",
+//   "frame_ms_lo","frame_ms_hi","frame_n","precompute_ms","flicker"}}}
+// flip_mean is accuracy vs the reference golden and flip_noise its noise floor (drift.h);
+// frame_ms the median of the repeated timings, frame_ms_lo/hi their range; spirv_ipp the
+// deterministic cost. Numbers absent from the results are left out.
 nlohmann::json history_entry(const nlohmann::json& results);
 
 // Appends `entry` as one line (creating the file and its folder).

@@ -74,7 +74,7 @@ struct Checker {
         if (const json* m = object(obj, where, key))
             for (auto& [k, v] : m->items())
                 if (!v.is_number() && !v.is_null())
-                    fail(where, fmt::format("'{}.{}' must be a number, not {}", key, k, type_name(v)));
+                    fail(where, fmt::format("'{}.{}' must be a number, not {}", key, k, v.type_name()));
     }
 };
 
@@ -92,10 +92,27 @@ void check_test(const Checker& c, const json& t, size_t i) {
     const std::string verdict = t["verdict"].get<std::string>();
     if (!verdicts().count(verdict))
         c.fail(where, fmt::format("verdict '{}' is not one of pass, fail, improved, missing-golden, error", verdict));
-    for (const char* k : {"suite", "scene", "method", "env", "variant", "message", "bless_command", "driver_mismatch", "image"})
+    for (const char* k : {"suite", "scene", "method", "env", "variant", "message", "bless_command", "driver_mismatch", "image",
+                          "image_exr"})
         c.string_(t, where, k);
     for (const char* k : {"width", "height", "precompute_ms", "frame_ms", "texture_fetches_per_pixel"})
         c.number(t, where, k);
+    c.number_map(t, where, "cost");
+    if (const json* smp = c.array(t, where, "frame_ms_samples"))
+        for (size_t k = 0; k < smp->size(); ++k)
+            if (!(*smp)[k].is_number())
+                c.fail(where, fmt::format("'frame_ms_samples[{}]' must be a number, not {}", k, (*smp)[k].type_name()));
+    if (const json* lay = c.object(t, where, "layout")) {
+        c.string_(*lay, where + ": layout", "id_map");
+        if (const json* sp = c.array(*lay, where + ": layout", "spheres"))
+            for (size_t k = 0; k < sp->size(); ++k) {
+                const std::string sw = fmt::format("{}: layout.spheres[{}]", where, k);
+                if (!(*sp)[k].is_object()) c.fail(sw, fmt::format("must be an object, not {}", (*sp)[k].type_name()));
+                c.string_((*sp)[k], sw, "label");
+                c.number((*sp)[k], sw, "roughness");
+                c.number((*sp)[k], sw, "metallic");
+            }
+    }
     if (const json* o = c.object(t, where, "options"))
         for (auto& [k, v] : o->items())
             if (v.is_object() || v.is_array())
@@ -125,8 +142,17 @@ void check_test(const Checker& c, const json& t, size_t i) {
                     c.number(ck, kw, "value");
                     c.number(ck, kw, "min");
                     c.number(ck, kw, "max");
+                    c.number(ck, kw, "approved");
                     c.string_(ck, kw, "status");
                 }
+            if (const json* wb = c.object(cmp, cw, "worst_block")) {
+                for (const char* k : {"x", "y", "flip"}) c.number(*wb, cw + ": worst_block", k);
+                c.string_(*wb, cw + ": worst_block", "sphere");
+            }
+            if (const json* ap = c.object(cmp, cw, "approved"))
+                for (auto& [k, v] : ap->items())
+                    if (!v.is_string() && !v.is_null())
+                        c.fail(cw, fmt::format("approved.{} must be a string, not {}", k, v.type_name()));
             if (const json* imgs = c.object(cmp, cw, "images"))
                 for (auto& [k, v] : imgs->items())
                     if (!v.is_string() && !v.is_null())

@@ -34,6 +34,50 @@ std::vector<size_t> pareto_front(const std::vector<std::pair<double, double>>& p
     return front;
 }
 
+const std::vector<std::string>& marker_shapes() {
+    static const std::vector<std::string> shapes{"circle", "square", "triangle", "diamond", "triangle-down",
+                                                 "cross", "plus", "star", "hexagon"};
+    return shapes;
+}
+
+std::string marker_svg(const std::string& shape, double x, double y, double r, const std::string& fill,
+                       const std::string& cls, bool hollow) {
+    const std::string c = "point" + std::string(hollow ? " hollow" : "") + (cls.empty() ? "" : " " + cls);
+    // A hollow marker is an outline in the colour (inline style: it must win over the charts' CSS).
+    const std::string paint = hollow ? fmt::format("fill=\"#fff\" stroke=\"{0}\" style=\"stroke:{0}\"", html_escape(fill))
+                                     : fmt::format("fill=\"{}\" stroke=\"#fff\"", html_escape(fill));
+    auto poly = [&](std::vector<std::pair<double, double>> pts) {
+        std::string d;
+        for (size_t i = 0; i < pts.size(); ++i)
+            d += fmt::format("{}{:.1f},{:.1f}", i ? "L" : "M", x + pts[i].first * r, y + pts[i].second * r);
+        return fmt::format("<path class=\"{}\" d=\"{}Z\" {}", c, d, paint);
+    };
+    if (shape == "square") return poly({{-0.85, -0.85}, {0.85, -0.85}, {0.85, 0.85}, {-0.85, 0.85}});
+    if (shape == "triangle") return poly({{0, -1.15}, {1.05, 0.75}, {-1.05, 0.75}});
+    if (shape == "triangle-down") return poly({{0, 1.15}, {1.05, -0.75}, {-1.05, -0.75}});
+    if (shape == "diamond") return poly({{0, -1.2}, {1.0, 0}, {0, 1.2}, {-1.0, 0}});
+    if (shape == "cross")
+        return poly({{-1, -0.6}, {-0.6, -1}, {0, -0.4}, {0.6, -1}, {1, -0.6}, {0.4, 0}, {1, 0.6}, {0.6, 1}, {0, 0.4},
+                     {-0.6, 1}, {-1, 0.6}, {-0.4, 0}});
+    if (shape == "plus")
+        return poly({{-0.3, -1}, {0.3, -1}, {0.3, -0.3}, {1, -0.3}, {1, 0.3}, {0.3, 0.3}, {0.3, 1}, {-0.3, 1},
+                     {-0.3, 0.3}, {-1, 0.3}, {-1, -0.3}, {-0.3, -0.3}});
+    if (shape == "star") {
+        std::vector<std::pair<double, double>> p;
+        for (int i = 0; i < 10; ++i) {
+            const double a = -1.5707963 + i * 0.6283185, rr = i % 2 ? 0.5 : 1.25;
+            p.emplace_back(rr * std::cos(a), rr * std::sin(a));
+        }
+        return poly(p);
+    }
+    if (shape == "hexagon") {
+        std::vector<std::pair<double, double>> p;
+        for (int i = 0; i < 6; ++i) p.emplace_back(1.05 * std::cos(i * 1.0471976), 1.05 * std::sin(i * 1.0471976));
+        return poly(p);
+    }
+    return fmt::format("<circle class=\"{}\" cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"{}\" {}", c, x, y, r, paint);
+}
+
 namespace {
 
 struct Scale {
@@ -62,11 +106,20 @@ Scale make_scale(const ChartAxis& ax, std::vector<double> vals, double p0, doubl
     if (ax.min) mn = *ax.min;
     if (ax.max) mx = *ax.max;
     if (ax.log) {
-        int e0 = int(std::floor(std::log10(mn))), e1 = int(std::ceil(std::log10(mx)));
-        if (e1 <= e0) e1 = e0 + 1;
-        s.lo = std::pow(10.0, e0);
-        s.hi = std::pow(10.0, e1);
-        const bool fine = e1 - e0 <= 2;
+        // The domain snaps to the nearest 1-2-5 steps around the data, not to whole decades.
+        auto step_down = [](double v) {
+            const double p = std::pow(10.0, std::floor(std::log10(v)));
+            return v >= 5 * p ? 5 * p : v >= 2 * p ? 2 * p : p;
+        };
+        auto step_up = [](double v) {
+            const double p = std::pow(10.0, std::floor(std::log10(v)));
+            return v <= p * 1.0000001 ? p : v <= 2 * p ? 2 * p : v <= 5 * p ? 5 * p : 10 * p;
+        };
+        s.lo = ax.min ? *ax.min : step_down(mn);
+        s.hi = ax.max ? *ax.max : step_up(mx);
+        if (s.hi <= s.lo) s.hi = step_up(s.lo * 1.01);
+        const int e0 = int(std::floor(std::log10(s.lo))), e1 = int(std::ceil(std::log10(s.hi)));
+        const bool fine = std::log10(s.hi / s.lo) <= 3.01;
         for (int e = e0; e <= e1; ++e)
             for (double m : {1.0, 2.0, 5.0}) {
                 if (m != 1.0 && !fine) continue;
@@ -112,19 +165,24 @@ std::string render_chart(const Chart& c) {
             pts.push_back({&p, si});
             xs.push_back(p.x);
             ys.push_back(p.y);
+            if (p.xlo && std::isfinite(*p.xlo) && (!c.x.log || *p.xlo > 0)) xs.push_back(*p.xlo);
+            if (p.xhi && std::isfinite(*p.xhi)) xs.push_back(*p.xhi);
         }
 
     // Layout: plot on top, legend below it in rows that wrap (so two charts fit side by side).
-    const double W = 640, px0 = 64, px1 = W - 24, py0 = 48, py1 = 310;
+    const double W = c.width, px0 = 64, px1 = W - 18, py0 = c.note.empty() ? 30 : 44, py1 = py0 + c.plot_height;
     struct LegendItem {
         std::string name, color;
         bool dashed, pareto;
         double x, y;
     };
     std::vector<LegendItem> legend;
-    for (const ChartSeries& s : c.series) legend.push_back({s.name, s.color, s.dashed, false, 0, 0});
-    if (c.pareto) legend.push_back({"Pareto front (lower-left is better)", "#212529", true, true, 0, 0});
-    double lx = px0 - 40, ly = py1 + 64;
+    if (c.legend) {
+        for (const ChartSeries& s : c.series)
+            if (!s.name.empty()) legend.push_back({s.name, s.color, s.dashed, false, 0, 0});
+        if (c.pareto) legend.push_back({"Pareto front (lower-left is better)", "#212529", true, true, 0, 0});
+    }
+    double lx = px0 - 40, ly = py1 + (legend.empty() ? 46 : 64);
     for (LegendItem& it : legend) {
         const double w = 34 + 6.1 * double(it.name.size()) + 14;
         if (lx + w > W - 4 && lx > px0 - 40) lx = px0 - 40, ly += 18;
@@ -132,7 +190,7 @@ std::string render_chart(const Chart& c) {
         it.y = ly;
         lx += w;
     }
-    const double H = ly + 14;
+    const double H = legend.empty() ? py1 + 46 : ly + 14;
     const Scale sx = make_scale(c.x, xs, px0, px1);
     const Scale sy = make_scale(c.y, ys, py1, py0);
 
@@ -143,9 +201,9 @@ std::string render_chart(const Chart& c) {
                    "xmlns=\"http://www.w3.org/2000/svg\" width=\"{}\" height=\"{}\" viewBox=\"0 0 {} {}\" role=\"img\">\n",
                    html_escape(c.id), pts.size(), c.series.size(), skipped, W, H, W, H);
     fmt::format_to(out, "<title>{}</title>\n", html_escape(c.title));
-    fmt::format_to(out, "<text class=\"ctitle\" x=\"{}\" y=\"20\">{}</text>\n", px0, html_escape(c.title));
+    fmt::format_to(out, "<text class=\"ctitle\" x=\"{}\" y=\"18\">{}</text>\n", px0 - 40, html_escape(c.title));
     if (!c.note.empty())
-        fmt::format_to(out, "<text class=\"cnote\" x=\"{}\" y=\"36\">{}</text>\n", px0, html_escape(c.note));
+        fmt::format_to(out, "<text class=\"cnote\" x=\"{}\" y=\"33\">{}</text>\n", px0 - 40, html_escape(c.note));
     // Frame, grid, ticks.
     fmt::format_to(out, "<rect class=\"plot\" x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\"/>\n", px0, py0, px1 - px0,
                    py1 - py0);
@@ -166,7 +224,7 @@ std::string render_chart(const Chart& c) {
                        y, px0, px1, px0 - 5, px0 - 8, y + 4, fmt_num(t));
     }
     fmt::format_to(out, "<text class=\"al\" x=\"{}\" y=\"{}\" text-anchor=\"middle\">{}{}</text>\n", (px0 + px1) / 2,
-                   py1 + 40, html_escape(c.x.label), c.x.log ? " (log scale)" : "");
+                   py1 + 36, html_escape(c.x.label), c.x.log ? " (log scale)" : "");
     fmt::format_to(out,
                    "<text class=\"al\" transform=\"translate(16 {}) rotate(-90)\" text-anchor=\"middle\">{}{}</text>\n",
                    (py0 + py1) / 2, html_escape(c.y.label), c.y.log ? " (log scale)" : "");
@@ -224,11 +282,14 @@ std::string render_chart(const Chart& c) {
     for (auto& p : pts) {
         const ChartSeries& s = c.series[p.series];
         const double x = sx(p.p->x), y = sy(p.p->y);
-        std::string circle = fmt::format(
-            "<circle class=\"point\" cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"4.5\" fill=\"{}\" data-series=\"{}\" "
-            "data-x=\"{}\" data-y=\"{}\" data-label=\"{}\"><title>{}</title></circle>",
-            x, y, html_escape(s.color), html_escape(s.name), p.p->x, p.p->y, html_escape(p.p->label),
-            html_escape(p.p->tooltip.empty() ? p.p->label : p.p->tooltip));
+        if (p.p->xlo && p.p->xhi && (!c.x.log || *p.p->xlo > 0))
+            fmt::format_to(out, "<line class=\"range\" x1=\"{:.1f}\" y1=\"{:.1f}\" x2=\"{:.1f}\" y2=\"{:.1f}\" stroke=\"{}\"/>",
+                           sx(*p.p->xlo), y, sx(*p.p->xhi), y, html_escape(s.color));
+        std::string circle = marker_svg(s.marker, x, y, 4.5, s.color, "", s.hollow) +
+                             fmt::format(" data-series=\"{}\" data-x=\"{}\" data-y=\"{}\" data-label=\"{}\"><title>{}</title>{}",
+                                         html_escape(s.name), p.p->x, p.p->y, html_escape(p.p->label),
+                                         html_escape(p.p->tooltip.empty() ? p.p->label : p.p->tooltip),
+                                         s.marker == "circle" ? "</circle>" : "</path>");
         if (!p.p->href.empty())
             circle = fmt::format("<a href=\"{}\">{}</a>", html_escape(p.p->href), circle);
         o += circle;
@@ -238,7 +299,7 @@ std::string render_chart(const Chart& c) {
                 double lx = x + 7, ly = y + dy;
                 if (lx + w > px1 + 15) lx = x - 7 - w; // keep labels inside the plot
                 Box b{lx, ly - h + 2, lx + w, ly + 2};
-                if (b.y0 < py0 || b.y1 > py1) continue;
+                if (b.y0 < py0 || b.y1 > py1 || b.x0 < px0 - 2) continue;
                 if (std::any_of(placed.begin(), placed.end(), [&](const Box& q) { return q.hits(b); })) continue;
                 placed.push_back(b);
                 fmt::format_to(out, "<text class=\"pl\" x=\"{:.1f}\" y=\"{:.1f}\">{}</text>", lx, ly,
@@ -269,7 +330,7 @@ std::string render_chart(const Chart& c) {
 }
 
 Sparkline render_sparkline(const std::string& id, const std::string& test_name, const std::vector<SparkRun>& runs,
-                           double rel_threshold, double abs_floor, const std::string& unit) {
+                           const std::string& unit, const std::optional<Flag>& flag) {
     Sparkline r;
     const double W = 200, H = 44, x0 = 4, x1 = W - 4, y0 = 13, y1 = H - 4;
     std::vector<size_t> idx;
@@ -279,12 +340,16 @@ Sparkline render_sparkline(const std::string& id, const std::string& test_name, 
     double mn = 0, mx = 1;
     if (!idx.empty()) {
         mn = mx = *runs[idx[0]].value;
-        for (size_t i : idx) mn = std::min(mn, *runs[i].value), mx = std::max(mx, *runs[i].value);
+        for (size_t i : idx) {
+            mn = std::min(mn, *runs[i].value), mx = std::max(mx, *runs[i].value);
+            if (runs[i].lo && std::isfinite(*runs[i].lo)) mn = std::min(mn, *runs[i].lo);
+            if (runs[i].hi && std::isfinite(*runs[i].hi)) mx = std::max(mx, *runs[i].hi);
+        }
     }
-    if (!idx.empty()) r.range = fmt::format("{}–{}{}", fmt_num(mn), fmt_num(mx), unit);
-    // The vertical span is at least 20 % of the values (and abs_floor), so run-to-run noise of a
-    // few percent reads as flat instead of being stretched to the full height.
-    const double min_span = std::max({0.2 * std::max(std::fabs(mn), std::fabs(mx)), 2 * abs_floor, 1e-9});
+    if (!idx.empty()) r.range = fmt::format("{}\u2013{}{}", fmt_num(mn), fmt_num(mx), unit);
+    // The vertical span is at least 20 % of the values, so run-to-run noise of a few percent reads
+    // as flat instead of being stretched to the full height.
+    const double min_span = std::max(0.2 * std::max(std::fabs(mn), std::fabs(mx)), 1e-9);
     if (mx - mn < min_span) {
         const double mid = 0.5 * (mn + mx);
         mn = mid - 0.5 * min_span;
@@ -294,33 +359,26 @@ Sparkline render_sparkline(const std::string& id, const std::string& test_name, 
     auto X = [&](size_t i) { return x0 + (x1 - x0) * double(i) / n; };
     auto Y = [&](double v) { return y1 - (y1 - y0) * (v - mn) / (mx - mn); };
 
-    // Largest relative jump between consecutive present values.
-    double best = 0;
-    size_t best_i = 0;
-    for (size_t k = 1; k < idx.size(); ++k) {
-        const double a = *runs[idx[k - 1]].value, b = *runs[idx[k]].value;
-        const double d = std::fabs(b - a);
-        if (d < abs_floor) continue;
-        const double rel = d / std::max({std::fabs(a), 1e-12});
-        if (rel > best) best = rel, best_i = k;
-    }
     std::string o;
     auto out = std::back_inserter(o);
     fmt::format_to(out,
-                   "<svg class=\"chart spark\" data-chart=\"{}\" data-test=\"{}\" data-points=\"{}\" "
+                   "<svg class=\"chart spark\" data-chart=\"{}\" data-test=\"{}\" data-points=\"{}\" data-flagged=\"{}\" "
                    "xmlns=\"http://www.w3.org/2000/svg\" width=\"{}\" height=\"{}\" viewBox=\"0 0 {} {}\">",
-                   html_escape(id), html_escape(test_name), idx.size(), W, H, W, H);
-    if (best > rel_threshold && best_i > 0) {
-        const SparkRun& run = runs[idx[best_i]];
-        const double a = *runs[idx[best_i - 1]].value, b = *run.value;
+                   html_escape(id), html_escape(test_name), idx.size(), flag ? 1 : 0, W, H, W, H);
+    if (flag && flag->index < runs.size()) {
+        const SparkRun& run = runs[flag->index];
         r.moved_commit = run.commit;
-        r.moved = fmt::format("{}{:.0f}% at {}", b >= a ? "+" : "\u2212", 100 * best, run.commit);
-        const double x = X(idx[best_i]);
+        r.moved = flag->text;
+        const double x = X(flag->index);
         fmt::format_to(out,
                        "<line class=\"moved\" x1=\"{0:.1f}\" y1=\"9\" x2=\"{0:.1f}\" y2=\"{1}\"/>"
                        "<text class=\"moved\" x=\"{2:.1f}\" y=\"9\" text-anchor=\"{3}\" data-commit=\"{4}\">{4}</text>",
                        x, H, x, x > W / 2 ? "end" : "start", html_escape(run.commit));
     }
+    for (size_t i : idx)
+        if (runs[i].lo && runs[i].hi && *runs[i].hi > *runs[i].lo)
+            fmt::format_to(out, "<line class=\"rg\" x1=\"{0:.1f}\" y1=\"{1:.1f}\" x2=\"{0:.1f}\" y2=\"{2:.1f}\"/>", X(i),
+                           Y(*runs[i].lo), Y(*runs[i].hi));
     if (idx.size() >= 2) {
         std::string poly;
         for (size_t i : idx) poly += fmt::format("{:.1f},{:.1f} ", X(i), Y(*runs[i].value));
@@ -328,12 +386,14 @@ Sparkline render_sparkline(const std::string& id, const std::string& test_name, 
     }
     for (size_t k = 0; k < idx.size(); ++k) {
         const SparkRun& run = runs[idx[k]];
+        std::string range;
+        if (run.lo && run.hi) range = fmt::format(" (range {}\u2013{})", fmt_num(*run.lo), fmt_num(*run.hi));
         fmt::format_to(out,
                        "<circle class=\"point{}\" cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"{}\" data-commit=\"{}\" data-y=\"{}\">"
-                       "<title>{} {}: {}{}</title></circle>",
+                       "<title>{} {}: {}{}{}</title></circle>",
                        k + 1 == idx.size() ? " last" : "", X(idx[k]), Y(*run.value), k + 1 == idx.size() ? 3 : 1.8,
                        html_escape(run.commit), *run.value, html_escape(run.commit), html_escape(run.date),
-                       fmt_num(*run.value), html_escape(unit));
+                       fmt_num(*run.value), html_escape(unit), html_escape(range));
     }
     o += "</svg>";
     r.svg = std::move(o);

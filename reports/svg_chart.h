@@ -8,6 +8,8 @@
 #include <string_view>
 #include <vector>
 
+#include "reports/drift.h"
+
 namespace iblcheck::report {
 
 // Escapes & < > " ' for text and attribute values.
@@ -17,6 +19,7 @@ std::string fmt_num(double v);
 
 struct ChartPoint {
     double x = 0, y = 0;
+    std::optional<double> xlo, xhi; // a horizontal range drawn through the point (repeated timings)
     std::string label;   // drawn next to the point (may be empty)
     std::string tooltip; // <title>
     std::string href;    // optional link (e.g. "#t-3": the test's card)
@@ -27,8 +30,20 @@ struct ChartSeries {
     std::string color;
     bool dashed = false;
     bool connect = false; // draw a line through the points (sorted by x)
+    // circle, square, triangle, diamond, triangle-down, cross, plus, star, hexagon (marker_shapes())
+    std::string marker = "circle";
+    bool hollow = false;  // marker drawn as an outline
     std::vector<ChartPoint> points;
 };
+
+inline ChartSeries make_series(std::string name, std::string color, bool dashed = false, bool connect = false) {
+    ChartSeries s;
+    s.name = std::move(name);
+    s.color = std::move(color);
+    s.dashed = dashed;
+    s.connect = connect;
+    return s;
+}
 
 struct ChartAxis {
     std::string label;
@@ -43,7 +58,15 @@ struct Chart {
     ChartAxis x, y;
     std::vector<ChartSeries> series;
     bool pareto = false; // draw the Pareto front over all points (lower-left is better)
+    double width = 640, plot_height = 262; // a small multiple is smaller
+    bool legend = true;  // small multiples share one legend outside the panels
 };
+
+// The marker shapes a series may use, in the order variants are given them.
+const std::vector<std::string>& marker_shapes();
+// An SVG element (class "point" plus `cls`) drawing `shape` centred on (x, y).
+std::string marker_svg(const std::string& shape, double x, double y, double r, const std::string& fill,
+                       const std::string& cls, bool hollow);
 
 std::string render_chart(const Chart& chart);
 
@@ -54,20 +77,19 @@ std::vector<size_t> pareto_front(const std::vector<std::pair<double, double>>& p
 struct SparkRun {
     std::string commit, date;
     std::optional<double> value;
+    std::optional<double> lo, hi;  // the run's measured range (repeated timings), drawn as a bar
 };
 
 struct Sparkline {
     std::string svg;
-    std::string moved;      // "+35% at f554dd9" when the largest jump passes the threshold; else ""
+    std::string moved;      // the flag's text ("+3.1 % at c4 (noise floor 0.0017)"); else ""
     std::string moved_commit;
     std::string range;      // "0.03–0.052 ms": the values' span
     size_t points = 0;
 };
 
-// A trend line over `runs` (oldest first). The largest relative jump between consecutive values
-// is marked with the commit that made it when it exceeds `rel_threshold` (0.10 = 10 %) and
-// `abs_floor` (ignores noise on values near 0).
+// A trend line over `runs` (oldest first); `flag` (drift.h) marks the run that moved.
 Sparkline render_sparkline(const std::string& id, const std::string& test_name, const std::vector<SparkRun>& runs,
-                           double rel_threshold, double abs_floor, const std::string& unit);
+                           const std::string& unit, const std::optional<Flag>& flag);
 
 } // namespace iblcheck::report

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Installs everything iblcheck needs from Debian's packages (the report needs no front-end
-# package: its page is plain HTML/SVG/JS written by reports/). Idempotent: installs only what is
+# Installs everything iblcheck needs from Debian's packages (the report has no JavaScript library:
+# its charts and image viewer are written by the program). Idempotent: installs only what is
 # missing. Safe to run on every invocation of the README's commands; when nothing is missing it
 # takes about a second.
 set -euo pipefail
@@ -14,7 +14,7 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   nlohmann-json3-dev libcli11-dev libfmt-dev
   clang-format clang-tidy
-  xz-utils
+  xz-utils zlib1g-dev
 )
 # Optional: the report's browser test runs where chromium is present; set IBLCHECK_NO_CHROMIUM=1 to skip it.
 if [[ "${IBLCHECK_NO_CHROMIUM:-0}" != 1 ]]; then PACKAGES+=(chromium); fi

@@ -3,10 +3,13 @@
 // `ci` suite fail on exactly the tests it affects, `iblcheck bisect` follows git bisect's contract.
 #include <gtest/gtest.h>
 
+#include <fmt/format.h>
+
 #include <array>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <regex>
 #include <set>
 #include <sys/wait.h>
 
@@ -99,6 +102,30 @@ TEST(Suite, ShardsPartitionTheSuite) {
     for (auto& t : ci.tests) EXPECT_EQ(seen.count(t.name), 1u) << t.name;
     EXPECT_EQ(select_tests(ci, "mobile.furnace.*", 0, 1).size(), 2u);
     EXPECT_THROW(select_tests(ci, "", 3, 3), UsageError);
+}
+
+// The "approve all failures" line names each failing test in one --filter: globs joined by '|'.
+TEST(Suite, FilterTakesSeveralGlobsSeparatedByBars) {
+    Suite ci = load_suite("ci");
+    EXPECT_EQ(select_tests(ci, "mobile.furnace.*|mobile.sphere.studio.default", 0, 1).size(), 3u);
+    EXPECT_EQ(select_tests(ci, "mobile.grazing.studio.default|nothing.like.this", 0, 1).size(), 1u);
+    EXPECT_TRUE(glob_match("a.b|c.*", "c.d"));
+    EXPECT_FALSE(glob_match("a.b|c.*", "a.bc"));
+    EXPECT_TRUE(glob_match("", "anything"));
+    EXPECT_FALSE(glob_match("|", "x")) << "an empty alternative matches nothing but the empty name";
+    std::string err;
+    const fs::path dir = temp_dir("repeats");
+    try {
+        write_file(dir / "r.json",
+                   R"({"suite": "r", "defaults": {"timing_repeats": 0}, "tests": [{"scene": "sphere", "method": "mobile"}]})");
+        load_suite((dir / "r.json").string());
+    } catch (const InputError& e) {
+        err = e.what();
+    }
+    fs::remove_all(dir);
+    EXPECT_NE(err.find("defaults.timing_repeats: must be an integer in 1..20"), std::string::npos) << err;
+    EXPECT_EQ(load_suite("nightly").timing_repeats, 3);
+    EXPECT_EQ(ci.timing_repeats, 1);
 }
 
 TEST(Harness, MissingGoldenThenBlessThenPassThenImproved) {
@@ -228,6 +255,32 @@ TEST(Gate, ShaderChangeFailsExactlyTheAffectedCiTestsAndBisectFollowsTheContract
         }
     }
     EXPECT_GE(failed, 20);
+    // -q keeps the summary and the one line that approves every failure, and names exactly them.
+    std::string all;
+    for (auto& t : r["tests"])
+        if (t["verdict"] == "fail") all += (all.empty() ? "" : "|") + t["name"].get<std::string>();
+    EXPECT_NE(out.find(fmt::format("approve all {} failures (after looking at them): iblcheck bless --suite 'ci' --filter '{}'\n",
+                                   failed, all)),
+              std::string::npos)
+        << out;
+    EXPECT_NE(out.find(fmt::format("{} fail,", failed)), std::string::npos) << out;
+
+    // Without -q, each failure says what failed, where (the sphere), what it did to the accuracy
+    // against the truth (approved -> now) and the command that approves it.
+    rc = run_command(env + iblcheck_bin() + " run --suite ci --filter 'mobile.roughness_sweep.studio.default'", out);
+    EXPECT_EQ(rc, 1) << out;
+    EXPECT_TRUE(std::regex_search(out, std::regex(R"(\n +baseline: flip\.mean [0-9.e-]+ > 0\.001 \(\+)"))) << out;
+    EXPECT_TRUE(std::regex_search(
+        out, std::regex(R"(\n +baseline: worst 16x16 block at \(\d+,\d+\) on (metal|dielectric) r=[0-9.]+, mean FLIP )")))
+        << out;
+    EXPECT_TRUE(std::regex_search(
+        out, std::regex(R"(\n +accuracy vs truth: 0\.\d{4} -> 0\.\d{4} \([+-]\d+\.\d %\), band \[0\.\d{4}, 0\.\d{4}\]\n)")))
+        << out;
+    EXPECT_NE(out.find("\n          approve: iblcheck bless --suite 'ci' --filter 'mobile.roughness_sweep.studio.default'\n"),
+              std::string::npos) << out;
+    EXPECT_NE(out.find("approve all 1 failure (after looking at them): iblcheck bless --suite 'ci' --filter "
+                       "'mobile.roughness_sweep.studio.default'\n"),
+              std::string::npos) << out;
 
     // Without the change the suite passes again.
     rc = run_command(iblcheck_bin() + " run --suite ci -q", out);

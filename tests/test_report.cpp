@@ -1,7 +1,7 @@
-// The HTML report (issue 8): synthetic results with every verdict, images written with OpenCV,
+// The HTML report (issues 8, 17): synthetic results with every verdict (tests/report_fixture.h),
 // then plain parsing of index.html (order, bless command, chart points, escaping), the schema
-// errors, the history file, the `iblcheck report` command, and a headless Chromium check that the
-// page opens from file:// with no console error and every image loaded (plus a screenshot).
+// errors, the history file and what it flags, the float data scripts, the words a failure prints,
+// and the `iblcheck report` command. The page in headless Chromium: test_report_browser.cpp.
 #include <gtest/gtest.h>
 
 #include <CLI/CLI.hpp>
@@ -15,21 +15,25 @@
 #include <cstdlib>
 #include <fstream>
 #include <regex>
+#include <set>
 #include <sstream>
 #include <unistd.h>
 
 #include "harness/cli/report_command.h"
 #include "harness/common/errors.h"
 #include "reports/report_writer.h"
+#include "reports/drift.h"
+#include "reports/float_data.h"
 #include "reports/svg_chart.h"
+#include "reports/verdict_text.h"
+#include "tests/report_fixture.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
 using namespace iblcheck;
+using testutil::kEvilName;
 
 namespace {
-
-const std::string kEvilName = "mobile.evil.<script>alert('x')</script>&\"q\"";
 
 std::string slurp(const fs::path& p) {
     std::ifstream f(p, std::ios::binary);
@@ -42,243 +46,6 @@ size_t count(const std::string& hay, const std::string& needle) {
     size_t n = 0;
     for (size_t p = hay.find(needle); p != std::string::npos; p = hay.find(needle, p + needle.size())) ++n;
     return n;
-}
-
-// A small "render": spheres-ish gradient with a seedable shift, 8-bit BGR.
-cv::Mat fake_render(int w, int h, int shift) {
-    cv::Mat m(h, w, CV_8UC3);
-    for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x) {
-            const int cx = ((x / 48) * 48 + 24), cy = h / 2;
-            const double d = std::hypot(x - cx, y - cy) / 20.0;
-            const double v = d < 1 ? (1 - d * d) : 0.15;
-            m.at<cv::Vec3b>(y, x) = cv::Vec3b(cv::saturate_cast<uchar>(60 + 150 * v),
-                                              cv::saturate_cast<uchar>(40 + 180 * v + shift),
-                                              cv::saturate_cast<uchar>(30 + 200 * v * (x % 48) / 48.0 + shift));
-        }
-    return m;
-}
-
-cv::Mat fake_heatmap(int w, int h) {
-    cv::Mat g(h, w, CV_8UC1);
-    for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x) g.at<uchar>(y, x) = cv::saturate_cast<uchar>(((x * 7 + y * 3) % 97) * 2);
-    cv::Mat c;
-    cv::applyColorMap(g, c, cv::COLORMAP_MAGMA);
-    return c;
-}
-
-void write_png(const fs::path& root, const std::string& rel, const cv::Mat& m) {
-    fs::create_directories((root / rel).parent_path());
-    ASSERT_TRUE(cv::imwrite((root / rel).string(), m)) << rel;
-}
-
-json comparison(const std::string& kind, const std::string& dir, const std::string& verdict, double flip) {
-    return json{
-        {"kind", kind},
-        {"golden", "goldens/" + kind + "/x.exr"},
-        {"verdict", verdict},
-        {"metrics",
-         {{"flip", {{"mean", flip}, {"weighted_median", flip * 0.8}, {"p99", flip * 10}, {"max", 0.5},
-                    {"block_max", 0.2}, {"block_x", 96}, {"block_y", 16}, {"mode", "hdr"}}},
-          {"ssim", {{"mean", 0.99}}},
-          {"psnr", {{"db", 41.2}, {"rmse", 0.01}, {"max_abs", 0.3}}}}},
-        {"checks",
-         json::array({{{"metric", "flip.mean"}, {"value", flip}, {"min", nullptr}, {"max", 0.01},
-                       {"status", flip > 0.01 ? "fail" : "pass"}},
-                      {{"metric", "ssim.mean"}, {"value", 0.99}, {"min", 0.98}, {"max", nullptr}, {"status", "pass"}}})},
-        {"images",
-         {{"test", "images/" + dir + "/test.png"},
-          {"golden", "images/" + dir + "/" + kind + ".png"},
-          {"heatmap", "images/" + dir + "/" + kind + "_flip.png"}}}};
-}
-
-json make_test(const std::string& method, const std::string& scene, const std::string& env, const std::string& variant,
-               const std::string& verdict, const std::string& dir) {
-    json t;
-    t["name"] = method + "." + scene + "." + env + (variant.empty() ? "" : "." + variant);
-    t["suite"] = "ci";
-    t["scene"] = scene;
-    t["method"] = method;
-    t["env"] = env;
-    t["variant"] = variant;
-    t["options"] = json::object();
-    if (!variant.empty()) {
-        auto eq = variant.find('=');
-        t["options"][variant.substr(0, eq)] = variant.substr(eq + 1);
-    }
-    t["width"] = 192;
-    t["height"] = 48;
-    t["verdict"] = verdict;
-    t["message"] = verdict == "pass" ? "" : verdict + ": something";
-    t["bless_command"] = "iblcheck bless --suite ci --filter '" + t["name"].get<std::string>() + "'";
-    t["driver_mismatch"] = nullptr;
-    t["comparisons"] = json::array({comparison("baseline", dir, verdict == "fail" ? "fail" : "pass",
-                                               verdict == "fail" ? 0.0123 : 0.004)});
-    t["timings"] = json::array({{{"pass", "prefilter_ggx"}, {"ms", 12.1}, {"gpu", true}, {"precompute", true}},
-                                {{"pass", "shade_spheres"}, {"ms", 3.2}, {"gpu", true}, {"precompute", false}}});
-    return t;
-}
-
-json per_sphere(double scale) {
-    json a = json::array();
-    for (double r : {0.1, 0.4, 0.7, 1.0}) {
-        a.push_back({{"label", "metal r=" + std::to_string(r).substr(0, 3)}, {"roughness", r}, {"metallic", 1},
-                     {"flip_mean", scale * (0.02 + r * 0.05)}});
-        a.push_back({{"label", "plastic r=" + std::to_string(r).substr(0, 3)}, {"roughness", r}, {"metallic", 0},
-                     {"flip_mean", scale * (0.01 + r * 0.03)}});
-    }
-    return a; // 8 spheres
-}
-
-struct Fixture {
-    fs::path root, results_dir, out_dir;
-    json results;
-    std::vector<json> history;
-};
-
-// Builds the synthetic run once (images + results.json + history) and writes the report.
-Fixture& fixture() {
-    static Fixture f = [] {
-        Fixture f;
-        f.root = fs::temp_directory_path() / ("iblcheck_test_report_" + std::to_string(::getpid()));
-        fs::remove_all(f.root);
-        // Removed when the test process ends (set IBLCHECK_KEEP_TMP=1 to look at the report).
-        static const fs::path cleanup = f.root;
-        if (!std::getenv("IBLCHECK_KEEP_TMP"))
-            std::atexit([] {
-                std::error_code ec;
-                fs::remove_all(cleanup, ec);
-            });
-        f.results_dir = f.root / "run";
-        f.out_dir = f.root / "report";
-        const int W = 192, H = 48;
-
-        json tests = json::array();
-        // Listed passes first on purpose: the report must put failures first.
-        json t1 = make_test("sampled", "roughness_sweep", "studio", "samples=64", "pass", "t1");
-        t1["accuracy"] = {{"flip_mean", 0.011}, {"golden", "goldens/reference/roughness_sweep__studio.exr"}};
-        t1["frame_ms"] = 31.0;
-        t1["precompute_ms"] = 4.0;
-        t1["texture_fetches_per_pixel"] = 64;
-        t1["per_sphere"] = per_sphere(0.3);
-        tests.push_back(t1);
-
-        json t2 = make_test("mobile", "roughness_sweep", "studio", "dominant_dir=lagarde", "fail", "t2");
-        t2["message"] = "baseline: flip.mean 0.0123 > 0.0100 (+0.0023); worst 16x16 block at (96,16)";
-        t2["driver_mismatch"] = "golden made with Mesa 22.3.5, this run Mesa 22.3.6";
-        t2["accuracy"] = {{"flip_mean", 0.052}, {"golden", "goldens/reference/roughness_sweep__studio.exr"}};
-        t2["frame_ms"] = 3.2;
-        t2["precompute_ms"] = 40.1;
-        t2["texture_fetches_per_pixel"] = 2.5;
-        t2["per_sphere"] = per_sphere(1.0);
-        t2["stability"] = {{"noise_floor", {{"flip.mean", 0.0004}}}, {"margins", {{"flip.mean", 25.0}}}, {"flaky", false}};
-        tests.push_back(t2);
-
-        json t3 = make_test("mobile", "roughness_sweep", "studio", "dominant_dir=none", "improved", "t3");
-        t3["accuracy"] = {{"flip_mean", 0.061}};
-        t3["frame_ms"] = 3.0;
-        t3["precompute_ms"] = 38.0;
-        t3["texture_fetches_per_pixel"] = 2.0;
-        tests.push_back(t3);
-
-        json t4 = make_test("mobile", "furnace", "constant", "", "missing-golden", "t4");
-        t4["comparisons"] = json::array(); // no golden: nothing to compare, the rendering alone
-        t4["image"] = "images/t4/test.png";
-        tests.push_back(t4);
-
-        json t5 = make_test("sampled", "broken", "sky_sun", "", "error", "t5");
-        t5["message"] = "shader compile failed: prefilter.glsl:12: 'foo' : undeclared identifier";
-        t5["comparisons"] = json::array();
-        t5["accuracy"] = nullptr;
-        tests.push_back(t5);
-
-        json t6 = make_test("mobile", "rotation", "sky_sun", "temporal", "pass", "t6");
-        t6["options"] = json::object();
-        t6["accuracy"] = {{"flip_mean", 0.03}};
-        t6["frame_ms"] = 3.5;
-        t6["precompute_ms"] = 41.0;
-        t6["texture_fetches_per_pixel"] = 2.5;
-        t6["temporal"] = {{"frames", json::array()}, {"reference_frames", json::array()}, {"flicker", 0.01},
-                          {"variation_ratio", 1.3}, {"flip_mean", 0.02}};
-        for (int i = 0; i < 12; ++i) {
-            t6["temporal"]["frames"].push_back(fmt::format("images/t6/frame{:03d}.png", i));
-            t6["temporal"]["reference_frames"].push_back(fmt::format("images/t6/ref{:03d}.png", i));
-        }
-        tests.push_back(t6);
-
-        json t7 = make_test("sampled", "rotation", "sky_sun", "temporal", "pass", "t7");
-        t7["options"] = json::object();
-        t7["accuracy"] = {{"flip_mean", 0.014}};
-        t7["frame_ms"] = 28.0;
-        t7["precompute_ms"] = 3.0;
-        t7["texture_fetches_per_pixel"] = 64;
-        t7["temporal"] = {{"frames", t6["temporal"]["frames"]}, {"flicker", 0.004}, {"flip_mean", 0.012}};
-        tests.push_back(t7);
-
-        json t8 = make_test("mobile", "evil", "studio", "", "pass", "evil");
-        t8["name"] = kEvilName;
-        t8["message"] = "<b>bold</b> & \"quoted\"";
-        t8["accuracy"] = {{"flip_mean", 0.08}};
-        t8["frame_ms"] = 2.0;
-        tests.push_back(t8);
-
-        json t9 = make_test("reference", "roughness_sweep", "studio", "", "pass", "t9");
-        t9["comparisons"][0]["images"]["heatmap"] = "images/t9/does_not_exist.png"; // a placeholder, not an error
-        t9["frame_ms"] = 5000.0;
-        tests.push_back(t9);
-
-        f.results = {{"schema", "iblcheck-results/1"},
-                     {"suite", "ci"},
-                     {"command", "iblcheck run --suite ci --out report"},
-                     {"started", "2026-11-22T15:40:00Z"},
-                     {"total_s", 41.2},
-                     {"commit", "f554dd9"},
-                     {"dirty", true},
-                     {"driver",
-                      {{"device", "llvmpipe (LLVM 15.0.6, 256 bits)"}, {"driver", "llvmpipe"},
-                       {"driver_info", "Mesa 22.3.6 (LLVM 15.0.6)"}, {"mesa", "22.3.6"}, {"llvm", "15.0.6"},
-                       {"api", "1.3.230"}}},
-                     {"counts", {{"pass", 5}, {"fail", 1}, {"improved", 1}, {"missing-golden", 1}, {"error", 1}}},
-                     {"tests", tests}};
-
-        // Images.
-        for (const char* d : {"t1", "t2", "t3", "t4", "t5", "t6", "t7", "evil", "t9"}) {
-            write_png(f.results_dir, std::string("images/") + d + "/test.png", fake_render(W, H, 0));
-            write_png(f.results_dir, std::string("images/") + d + "/baseline.png", fake_render(W, H, 25));
-            write_png(f.results_dir, std::string("images/") + d + "/baseline_flip.png", fake_heatmap(W, H));
-        }
-        for (int i = 0; i < 12; ++i) {
-            cv::Mat fr = fake_render(96, 48, 0), rf = fake_render(96, 48, 0);
-            cv::circle(fr, {20 + 5 * i, 24}, 6, cv::Scalar(255, 255, 255), -1);
-            cv::circle(rf, {20 + 5 * i, 24}, 6, cv::Scalar(230, 240, 255), -1);
-            if (i % 3 == 1) fr *= 1.15; // flicker
-            write_png(f.results_dir, fmt::format("images/t6/frame{:03d}.png", i), fr);
-            write_png(f.results_dir, fmt::format("images/t6/ref{:03d}.png", i), rf);
-        }
-        {
-            std::ofstream(f.results_dir / "results.json") << f.results.dump(2);
-        }
-
-        // History: 6 older runs; the failing test's accuracy jumped at c4.
-        for (int i = 0; i < 6; ++i) {
-            json h = report::history_entry(f.results);
-            h["commit"] = fmt::format("c{}", i);
-            h["date"] = fmt::format("2026-11-{:02d}T03:00:00Z", 10 + i);
-            h["dirty"] = false;
-            for (auto& [name, v] : h["tests"].items()) {
-                if (v.contains("flip_mean")) v["flip_mean"] = v["flip_mean"].get<double>() * (1 + 0.01 * (i % 2));
-                if (v.contains("frame_ms")) v["frame_ms"] = v["frame_ms"].get<double>() * (1 + 0.02 * (i % 3));
-            }
-            h["tests"][t2["name"].get<std::string>()]["flip_mean"] = i < 4 ? 0.030 : 0.052;
-            h["tests"][t2["name"].get<std::string>()]["verdict"] = i < 4 ? "pass" : "fail";
-            report::append_history(f.root / "history.jsonl", h);
-        }
-        f.history = report::read_history(f.root / "history.jsonl");
-        report::write_report(f.results, f.results_dir, f.out_dir, f.history);
-        return f;
-    }();
-    return f;
 }
 
 std::string section_of(const std::string& html, const std::string& escaped_name) {
@@ -304,7 +71,9 @@ std::vector<ChartInfo> charts(const std::string& html) {
     for (auto it = std::sregex_iterator(html.begin(), html.end(), re); it != std::sregex_iterator(); ++it) {
         const size_t start = size_t(it->position(0));
         const size_t end = html.find("</svg>", start);
-        ChartInfo c{(*it)[1], std::stoi((*it)[2]), int(count(html.substr(start, end - start), "<circle class=\"point"))};
+        const std::string body = html.substr(start, end - start);
+        ChartInfo c{(*it)[1], std::stoi((*it)[2]),
+                    int(count(body, "<circle class=\"point") + count(body, "<path class=\"point"))};
         out.push_back(c);
     }
     return out;
@@ -319,7 +88,7 @@ int declared_points(const std::vector<ChartInfo>& cs, const std::string& id) {
 } // namespace
 
 TEST(Report, FailuresFirstInOrderOfSeverity) {
-    auto& f = fixture();
+    auto& f = testutil::small_run();
     const std::string html = slurp(f.out_dir / "index.html");
     std::regex re("<section class=\"test s-([a-z-]+) ");
     std::vector<std::string> order;
@@ -340,7 +109,7 @@ TEST(Report, FailuresFirstInOrderOfSeverity) {
 }
 
 TEST(Report, BlessCommandOnlyWhereNeeded) {
-    auto& f = fixture();
+    auto& f = testutil::small_run();
     const std::string html = slurp(f.out_dir / "index.html");
     const std::string fail = section_of(html, "mobile.roughness_sweep.studio.dominant_dir=lagarde");
     ASSERT_FALSE(fail.empty());
@@ -349,31 +118,66 @@ TEST(Report, BlessCommandOnlyWhereNeeded) {
               std::string::npos);
     EXPECT_NE(fail.find("golden made with Mesa 22.3.5"), std::string::npos);
     EXPECT_NE(fail.find("differences may come from the platform"), std::string::npos);
-    EXPECT_NE(fail.find("class=\"blk\" style=\"left:96px;top:16px\""), std::string::npos);
+    // The viewer knows the worst block and has its data (test, golden, FLIP map, sphere ids).
+    EXPECT_NE(fail.find("data-bx=\"96\" data-by=\"16\""), std::string::npos);
+    for (const char* k : {"data-test=\"", "data-golden=\"", "data-error=\"", "data-ids=\""}) EXPECT_NE(fail.find(k), std::string::npos) << k;
+    // What failed, in words: the check, where (sphere), the accuracy against the truth before -> after.
+    EXPECT_NE(fail.find("baseline: flip.mean 0.0123 &gt; 0.01"), std::string::npos) << fail.substr(0, 3000);
+    EXPECT_NE(fail.find("worst 16x16 block at (96,16) on metal r=0.3"), std::string::npos);
+    EXPECT_NE(fail.find("accuracy vs truth: 0.0300 -&gt; 0.0520 (+73.3 %), band [0.0270, 0.0330]"), std::string::npos);
     const std::string missing = section_of(html, "mobile.furnace.constant");
     EXPECT_NE(missing.find("iblcheck bless"), std::string::npos);
     EXPECT_NE(missing.find("src=\"images/t4/test.png\""), std::string::npos);
     EXPECT_NE(missing.find("no golden to compare with yet"), std::string::npos);
+    EXPECT_NE(missing.find("class=\"ev\""), std::string::npos) << "the rendering alone still gets its exposure control";
     EXPECT_EQ(section_of(html, "sampled.roughness_sweep.studio.samples=64").find("iblcheck bless"), std::string::npos);
     EXPECT_NE(html.find("image-rendering:pixelated"), std::string::npos);
     // Checks with tolerances and stability columns.
     EXPECT_NE(fail.find("<td class=\"st-fail\">fail</td>"), std::string::npos);
     EXPECT_NE(fail.find("25&times;"), std::string::npos);
-    // History: the jump of the failing test's accuracy is labelled with its commit.
-    EXPECT_NE(fail.find("FLIP moved +73% at c4"), std::string::npos) << fail.substr(fail.find("History:") == std::string::npos ? 0 : fail.find("History:"), 600);
+    // History: the jump of the failing test's accuracy is flagged at its commit (beyond the floor: 0 here).
+    EXPECT_NE(fail.find("accuracy moved +73.3 % at c4"), std::string::npos)
+        << fail.substr(fail.find("History:") == std::string::npos ? 0 : fail.find("History:"), 600);
+    // The summary says what changed since the baselines and approves every failure in one line.
+    EXPECT_NE(html.find("<th>shader tree</th><td><span class=\"mono\">aaaa</span> (1 test)</td><td class=\"mono\">bbbb</td>"
+                        "<td class=\"changed\">changed for 1 of 1</td>"),
+              std::string::npos);
+    EXPECT_NE(html.find("approve all 2 failures (after looking at them)</span><pre><code>iblcheck bless --suite &#39;ci&#39; "
+                        "--filter &#39;mobile.roughness_sweep.studio.dominant_dir=lagarde|mobile.furnace.constant&#39;"),
+              std::string::npos);
 }
 
-TEST(Report, ChartsHaveOnePointPerTest) {
-    auto& f = fixture();
+TEST(Report, ChartsAreSmallMultiplesOnTheStableCost) {
+    auto& f = testutil::small_run();
     const std::string html = slurp(f.out_dir / "index.html");
     const auto cs = charts(html);
     for (auto& c : cs) EXPECT_EQ(c.declared, c.circles) << c.id;
-    // accuracy + frame_ms: t1 t2 t3 t6 t7 evil (t9 has no accuracy).
-    EXPECT_EQ(declared_points(cs, "speed-accuracy"), 6);
-    EXPECT_EQ(declared_points(cs, "speed-accuracy-precompute"), 5);
-    EXPECT_EQ(declared_points(cs, "speed-accuracy-fetches"), 5);
-    EXPECT_EQ(declared_points(cs, "error-roughness"), 16);
-    EXPECT_EQ(declared_points(cs, "flicker-flip"), 2);
+    // Cost against accuracy, one panel per scene and environment, x = SPIR-V instructions per
+    // pixel: roughness_sweep/studio has t1 (sampled, 54000), t2 (6300), t3 (6200) with both.
+    EXPECT_EQ(declared_points(cs, "cost-accuracy-roughness-sweep-studio"), 3);
+    EXPECT_NE(html.find("SPIR-V instructions executed per pixel (deterministic)"), std::string::npos);
+    // t2 (6300, 0.052) is dominated by t3? No: t3 is cheaper (6200) but less accurate (0.061);
+    // the front is t3, t2, t1.
+    EXPECT_NE(html.find("class=\"pareto-front\" data-front=\"3\""), std::string::npos);
+    // Wall time: median and range, no front; t1's range 24-70 ms is drawn.
+    EXPECT_EQ(declared_points(cs, "wall-accuracy-roughness-sweep-studio"), 3);
+    EXPECT_NE(html.find("median of 3, range 24\u201370 ms"), std::string::npos);
+    {
+        const size_t w = html.find("data-chart=\"wall-accuracy-roughness-sweep-studio\"");
+        const std::string wall = html.substr(w, html.find("</svg>", w) - w);
+        EXPECT_EQ(wall.find("pareto-front"), std::string::npos) << "wall time never carries the front";
+        EXPECT_NE(wall.find("<line class=\"range\""), std::string::npos);
+    }
+    // Markers per variant family (dominant_dir and samples differ from the default's circle).
+    EXPECT_NE(html.find("data-series=\"mobile \u00b7 dominant_dir\""), std::string::npos);
+    EXPECT_NE(html.find("<path class=\"point\""), std::string::npos);
+    // Error against roughness: one panel per family against the default (t2: dominant_dir), and the
+    // sampled test's own panel.
+    EXPECT_EQ(declared_points(cs, "error-roughness-roughness-sweep-studio-dominant-dir"), 8);
+    EXPECT_EQ(declared_points(cs, "error-roughness-roughness-sweep-studio-sampled-samples"), 8);
+    // Flicker against FLIP: one panel per environment; labels say what differs, the env included.
+    EXPECT_EQ(declared_points(cs, "flicker-flip-rotation-sky-sun"), 2);
+    EXPECT_NE(html.find("data-label=\"mobile temporal \u00b7 sky_sun\""), std::string::npos);
     // Sparklines: 7 runs (6 stored + this one) for each test with that value.
     int spark = 0;
     for (auto& c : cs)
@@ -382,13 +186,7 @@ TEST(Report, ChartsHaveOnePointPerTest) {
             EXPECT_EQ(c.declared, 7);
         }
     EXPECT_EQ(spark, 6);
-    // The Pareto front over (frame_ms, flip): evil (2.0, 0.08), t3 (3.0, 0.061), t2 (3.2, 0.052),
-    // t6 (3.5, 0.03), t7 (28, 0.014), t1 (31, 0.011): all six are on it.
-    EXPECT_NE(html.find("class=\"pareto-front\" data-front=\"6\""), std::string::npos);
-    // Legend, tick labels, tooltips.
-    EXPECT_NE(html.find("Pareto front (lower-left is better)"), std::string::npos);
-    EXPECT_NE(html.find("frame time, ms (log scale)"), std::string::npos);
-    EXPECT_NE(html.find("<title>mobile.roughness_sweep.studio.dominant_dir=lagarde\nscene roughness_sweep"),
+    EXPECT_NE(html.find("<title>mobile.roughness_sweep.studio.dominant_dir=lagarde\n6300 SPIR-V instructions/pixel"),
               std::string::npos);
 }
 
@@ -401,9 +199,9 @@ TEST(Report, ParetoFront) {
 }
 
 TEST(Report, EscapesEveryString) {
-    auto& f = fixture();
+    auto& f = testutil::small_run();
     const std::string html = slurp(f.out_dir / "index.html");
-    EXPECT_EQ(count(html, "<script>"), 1u) << "only the report's own script";
+    EXPECT_EQ(count(html, "<script>"), 2u) << "only the report's own scripts (its configuration and its code)";
     EXPECT_EQ(html.find("alert('x')"), std::string::npos);
     EXPECT_EQ(html.find("<b>bold</b>"), std::string::npos);
     EXPECT_NE(html.find("mobile.evil.&lt;script&gt;alert(&#39;x&#39;)&lt;/script&gt;&amp;&quot;q&quot;"), std::string::npos);
@@ -412,7 +210,7 @@ TEST(Report, EscapesEveryString) {
 }
 
 TEST(Report, SelfContainedImagesAndMissingOnes) {
-    auto& f = fixture();
+    auto& f = testutil::small_run();
     const std::string html = slurp(f.out_dir / "index.html");
     EXPECT_TRUE(fs::exists(f.out_dir / "images/t2/baseline_flip.png"));
     EXPECT_TRUE(fs::exists(f.out_dir / "images/t6/frame011.png"));
@@ -428,6 +226,31 @@ TEST(Report, SelfContainedImagesAndMissingOnes) {
         EXPECT_TRUE(fs::exists(f.out_dir / src)) << src;
     }
     EXPECT_GT(n, 40);
+    // Every data script a viewer names is next to the page and holds what its meta says.
+    std::regex dre("data-(test|golden|error|ids)=\"([0-9a-f]{16})\"");
+    std::set<std::string> keys;
+    for (auto it = std::sregex_iterator(html.begin(), html.end(), dre); it != std::sregex_iterator(); ++it) keys.insert((*it)[2]);
+    EXPECT_EQ(keys.size(), 4u) << "the nine tests share their pixels: one script each for test, golden, error map, ids";
+    for (const std::string& k : keys) {
+        const std::string js = slurp(f.out_dir / "data" / (k + ".js"));
+        ASSERT_EQ(js.rfind("iblcheckData(\"" + k + "\",{", 0), 0u) << k;
+        const json meta = json::parse(js.substr(js.find(',') + 1, js.find("},\"") - js.find(',')));
+        const size_t q = js.find(",\"", js.find("},\"")) + 2;
+        std::string b64 = js.substr(q, js.rfind('"') - q), bytes;
+        for (size_t i = 0, acc = 0, bits = 0; i < b64.size(); ++i) {  // base64 -> bytes
+            const char ch = b64[i];
+            const int v = ch >= 'A' && ch <= 'Z' ? ch - 'A' : ch >= 'a' && ch <= 'z' ? ch - 'a' + 26
+                        : ch >= '0' && ch <= '9' ? ch - '0' + 52 : ch == '+' ? 62 : ch == '/' ? 63 : -1;
+            if (v < 0) continue;
+            acc = (acc << 6) | size_t(v);
+            bits += 6;
+            if (bits >= 8) bits -= 8, bytes += char((acc >> bits) & 0xff);
+        }
+        const size_t n_values = meta["w"].get<size_t>() * meta["h"].get<size_t>() * meta["c"].get<size_t>();
+        EXPECT_EQ(report::unpack(bytes).size(), n_values * (meta["enc"] == "u8" ? 1 : 2)) << k;
+    }
+    // The grid's thumbnails are the renders at their automatic exposure, written beside the page.
+    EXPECT_NE(html.find("<img class=\"thumb\" src=\"thumbs/"), std::string::npos);
     // Temporal: a filmstrip of the first 8 frames of each sequence, and a player over all 12.
     const std::string t6 = section_of(html, "mobile.rotation.sky_sun.temporal");
     EXPECT_EQ(count(t6, "class=\"frame\""), 16u);
@@ -439,8 +262,29 @@ TEST(Report, SelfContainedImagesAndMissingOnes) {
     EXPECT_TRUE(fs::exists(f.results_dir / "images/t1/test.png"));
 }
 
+// Results without float data (an older harness): the viewer is the PNGs side by side, no controls.
+TEST(Report, ResultsWithoutEXRsShowThePNGs) {
+    auto& f = testutil::small_run();
+    json r = f.results;
+    for (json& t : r["tests"]) {
+        t.erase("image_exr");
+        for (json& c : t["comparisons"])
+            if (c.contains("images"))
+                for (const char* k : {"test_exr", "golden_exr", "error_exr"}) c["images"].erase(k);
+    }
+    const fs::path out = f.root / "no_exr";
+    report::write_report(r, f.results_dir, out);
+    const std::string html = slurp(out / "index.html");
+    EXPECT_EQ(html.find("data-test=\""), std::string::npos);
+    EXPECT_EQ(html.find("class=\"ev\""), std::string::npos) << "no exposure control without float data";
+    const std::string fail = section_of(html, "mobile.roughness_sweep.studio.dominant_dir=lagarde");
+    EXPECT_NE(fail.find("<img class=\"gold\" src=\"images/t2/baseline.png\""), std::string::npos) << fail.substr(0, 4000);
+    EXPECT_NE(fail.find("worst 16&times;16 block at (96,16)"), std::string::npos);
+    EXPECT_FALSE(fs::exists(out / "data"));
+}
+
 TEST(Report, MalformedResultsNameFileAndProblem) {
-    auto& f = fixture();
+    auto& f = testutil::small_run();
     auto expect_error = [&](json r, const std::string& what) {
         try {
             report::write_report(r, f.root / "bad", f.root / "bad_out");
@@ -482,7 +326,7 @@ TEST(Report, MalformedResultsNameFileAndProblem) {
 }
 
 TEST(Report, HistoryFile) {
-    auto& f = fixture();
+    auto& f = testutil::small_run();
     EXPECT_TRUE(report::read_history(f.root / "no_such_history.jsonl").empty());
     ASSERT_EQ(f.history.size(), 6u);
     const json e = report::history_entry(f.results);
@@ -496,6 +340,19 @@ TEST(Report, HistoryFile) {
     EXPECT_DOUBLE_EQ(t2["precompute_ms"].get<double>(), 40.1);
     EXPECT_FALSE(t2.contains("flicker"));
     EXPECT_DOUBLE_EQ(e["tests"]["mobile.rotation.sky_sun.temporal"]["flicker"].get<double>(), 0.01);
+    // The repeated timings' range and the deterministic cost go into the history too.
+    const json& t1 = e["tests"]["sampled.roughness_sweep.studio.samples=64"];
+    EXPECT_DOUBLE_EQ(t1["frame_ms"].get<double>(), 31.0);
+    EXPECT_DOUBLE_EQ(t1["frame_ms_lo"].get<double>(), 24.0);
+    EXPECT_DOUBLE_EQ(t1["frame_ms_hi"].get<double>(), 70.0);
+    EXPECT_EQ(t1["frame_n"], 3);
+    EXPECT_DOUBLE_EQ(t1["spirv_ipp"].get<double>(), 54000.0);
+    // The accuracy's noise floor: --stability's measured floor first, else the truth's seed noise.
+    json r = f.results;
+    r["tests"][0]["accuracy"]["noise_floor"] = {{"mean_flip", 0.0017}};
+    EXPECT_DOUBLE_EQ(report::history_entry(r)["tests"]["sampled.roughness_sweep.studio.samples=64"]["flip_noise"].get<double>(), 0.0017);
+    r["tests"][0]["stability"] = {{"noise_floor", {{"accuracy.flip.mean", 0.004}}}};
+    EXPECT_DOUBLE_EQ(report::history_entry(r)["tests"]["sampled.roughness_sweep.studio.samples=64"]["flip_noise"].get<double>(), 0.004);
     EXPECT_EQ(e.dump().find('\n'), std::string::npos);
 
     const fs::path bad = f.root / "bad_history.jsonl";
@@ -509,7 +366,7 @@ TEST(Report, HistoryFile) {
 }
 
 TEST(Report, ReportCommandRebuildsFromStoredResults) {
-    auto& f = fixture();
+    auto& f = testutil::small_run();
     const fs::path out = f.root / "cli_out";
     CLI::App app;
     int exit_code = -1;
@@ -524,80 +381,106 @@ TEST(Report, ReportCommandRebuildsFromStoredResults) {
     EXPECT_TRUE(fs::exists(out / "images/t2/test.png"));
 }
 
-// ---- headless Chromium: the page opens from file://, no console error, every image loads ----
 
-namespace {
-const char* kChromium = "/usr/bin/chromium";
+// ---- what the history flags (drift.h) ----
 
-int run_chromium(const fs::path& profile, const std::string& extra, const fs::path& html, const fs::path& out,
-                 const fs::path& err) {
-    const std::string cmd = fmt::format(
-        "timeout 60 {} --headless --no-sandbox --disable-gpu --disable-quic --no-first-run "
-        "--disable-background-networking --disable-component-update --disable-sync --user-data-dir='{}' "
-        "--virtual-time-budget=5000 --enable-logging=stderr --v=0 {} 'file://{}' >'{}' 2>'{}'",
-        kChromium, profile.string(), extra, html.string(), out.string(), err.string());
-    return std::system(cmd.c_str());
+TEST(Drift, AccuracyMovesAreFlaggedBeyondTheNoiseFloorOnly) {
+    using report::accuracy_flag;
+    const std::vector<std::string> c{"a", "b", "c", "d", "e"};
+    // +3 % (0.2300 -> 0.2369) is beyond a floor of 0.0017: flagged at the commit that made it.
+    auto f = accuracy_flag({0.2300, 0.2301, 0.2299, 0.2369, 0.2370}, c, 0.0017);
+    ASSERT_TRUE(f);
+    EXPECT_EQ(f->index, 3u);
+    EXPECT_EQ(f->text, "+3.0 % at d (noise floor 0.0017)");
+    // Steps within the floor are noise...
+    EXPECT_FALSE(accuracy_flag({0.2300, 0.2310, 0.2300, 0.2312, 0.2305}, c, 0.0017));
+    // ...unless they add up to more than it: a slow drift is flagged from first to last.
+    f = accuracy_flag({0.2300, 0.2312, 0.2324, 0.2336, 0.2348}, c, 0.0017);
+    ASSERT_TRUE(f);
+    EXPECT_EQ(f->index, 4u);
+    EXPECT_EQ(f->text, "+2.1 % over 5 runs since a (noise floor 0.0017)");
+    // Runs without the value are skipped; one value is no trend.
+    EXPECT_FALSE(accuracy_flag({std::nullopt, 0.23, std::nullopt}, {"a", "b", "c"}, 0.0));
+    f = accuracy_flag({0.23, std::nullopt, 0.25}, {"a", "b", "c"}, 0.001);
+    ASSERT_TRUE(f);
+    EXPECT_EQ(f->index, 2u);
 }
 
-std::string attr(const std::string& tag, const std::string& name) {
-    std::smatch m;
-    if (std::regex_search(tag, m, std::regex(name + "=\"([^\"]*)\""))) return m[1];
-    return "";
+TEST(Drift, TimingIsFlaggedOnlyOutsideItsMeasuredSpread) {
+    using report::Spread;
+    using report::timing_flag;
+    const std::vector<std::string> c{"a", "b", "c", "d", "e"};
+    // 2.2-5.5x noise between identical runs: a median of 12 inside [5, 14] is not a change.
+    std::vector<std::optional<Spread>> s{Spread{5, 6, 11}, Spread{6, 9, 14}, Spread{5.5, 7, 12}, Spread{9, 12, 13}};
+    EXPECT_FALSE(timing_flag(s, c));
+    // A run whose whole range lies above everything measured before it is.
+    s.push_back(Spread{30, 33, 35});
+    auto f = timing_flag(s, c);
+    ASSERT_TRUE(f);
+    EXPECT_EQ(f->index, 4u);
+    EXPECT_NE(f->text.find("at e (outside the 5\u201314 measured before)"), std::string::npos) << f->text;
+    // Two runs are needed before anything can be judged.
+    EXPECT_FALSE(timing_flag({Spread{1, 1, 1}, Spread{9, 9, 9}}, c));
+    // Just outside a narrow hull is a new extreme, not a change: 14.5 is 0.5 beyond [5, 14] (9 wide).
+    EXPECT_FALSE(timing_flag({Spread{5, 6, 11}, Spread{6, 9, 14}, Spread{14.5, 15, 16}}, c));
+    // Faster counts too.
+    f = timing_flag({Spread{10, 11, 12}, Spread{10, 11, 13}, Spread{3, 3.5, 4}}, c);
+    ASSERT_TRUE(f);
+    EXPECT_EQ(f->index, 2u);
+    EXPECT_EQ(f->text.rfind("-65.0 % at c", 0), 0u) << f->text;
 }
-} // namespace
 
-TEST(ReportBrowser, OpensOfflineWithEveryImageLoaded) {
-    if (!fs::exists(kChromium)) GTEST_SKIP() << kChromium << " is not installed (Debian package chromium): "
-                                             << "the headless check of the report is skipped";
-    auto& f = fixture();
-    const fs::path html = fs::absolute(f.out_dir / "index.html");
-    const fs::path dom = f.root / "dom.html", err = f.root / "chromium.stderr";
-    const auto t0 = std::chrono::steady_clock::now();
-    const int rc = run_chromium(f.root / "profile1", "--dump-dom", html, dom, err);
-    ASSERT_EQ(rc, 0) << slurp(err);
-    const std::string d = slurp(dom), log = slurp(err);
+// ---- the float data the page's viewer decodes (float_data.h) ----
 
-    // No console error from the page.
-    std::istringstream ls(log);
-    for (std::string line; std::getline(ls, line);)
-        if (line.find("CONSOLE") != std::string::npos &&
-            (line.find("Uncaught") != std::string::npos || line.find("rror") != std::string::npos ||
-             line.find("Failed to load") != std::string::npos))
-            ADD_FAILURE() << "console: " << line;
+TEST(FloatData, HalfFloatsSurviveThePackingAndTheAutoExposureSeesTheBrightEnd) {
+    cv::Mat m(4, 8, CV_32FC3);
+    for (int y = 0; y < 4; ++y)
+        for (int x = 0; x < 8; ++x) m.at<cv::Vec3f>(y, x) = cv::Vec3f(0.1f * float(x), 1.0f / float(1 + y), 1e5f * float(x == 7));
+    const std::vector<uint16_t> h = report::to_half(m);
+    ASSERT_EQ(h.size(), 96u);
+    EXPECT_EQ(h[1], 0x3c00) << "1.0";
+    EXPECT_EQ(h[3 * 7 + 2], 0x7bff) << "1e5 is clamped to 65504, not infinity";
+    EXPECT_EQ(h[3 * 1 + 0], 0x2e66) << "0.1 rounds to nearest even";
+    const std::vector<uint8_t> planes = report::unpack(report::pack_half(h));
+    ASSERT_EQ(planes.size(), 192u);
+    for (size_t i = 0; i < h.size(); ++i) ASSERT_EQ(uint16_t(planes[i] | planes[h.size() + i] << 8), h[i]) << i;
+    EXPECT_EQ(report::base64("Man"), "TWFu");
+    EXPECT_EQ(report::base64("Ma"), "TWE=");
+    EXPECT_EQ(report::base64("M"), "TQ==");
+    // Auto exposure: the 99th percentile of a constant image of luminance 4 reaches 0.85 after
+    // the tone map: the ACES fit with the 0.6 pre-exposure gives 0.852 at x = 2.14, so log2(2.14 / 4) = -0.9.
+    cv::Mat c4(8, 8, CV_32FC3, cv::Scalar(4, 4, 4));
+    EXPECT_NEAR(report::auto_exposure(c4), -0.9, 0.05);
+    EXPECT_DOUBLE_EQ(report::auto_exposure(cv::Mat(8, 8, CV_32FC3, cv::Scalar(0, 0, 0))), 0.0);
+    // A sun in one pixel of 100 does not set the exposure.
+    cv::Mat sun(10, 10, CV_32FC3, cv::Scalar(4, 4, 4));
+    sun.at<cv::Vec3f>(0, 0) = cv::Vec3f(1e5f, 1e5f, 1e5f);
+    EXPECT_NEAR(report::auto_exposure(sun), report::auto_exposure(c4), 0.05);
+}
 
-    std::smatch m;
-    ASSERT_TRUE(std::regex_search(d, m, std::regex("<body[^>]*>"))) << d.substr(0, 2000);
-    const std::string body = m[0];
-    ASSERT_EQ(attr(body, "data-check"), "done") << "the page's load check did not run: " << body;
-    const std::string source = slurp(html);
-    const size_t img_tags = count(source, "<img ");
-    EXPECT_EQ(attr(body, "data-images-total"), std::to_string(img_tags)) << body;
-    EXPECT_EQ(attr(body, "data-images-failed"), "0") << attr(body, "data-images-failed-src");
-    EXPECT_EQ(attr(body, "data-chart-points"), attr(body, "data-chart-points-declared")) << body;
-    int declared = 0;
-    for (auto& c : charts(source)) declared += c.declared;
-    EXPECT_EQ(attr(body, "data-chart-points"), std::to_string(declared)) << body;
-    EXPECT_EQ(attr(body, "data-tests"), "9");
-    // The filter script ran (it writes the count line).
-    EXPECT_NE(d.find("9 of 9 tests shown"), std::string::npos);
+// ---- what a failure says (verdict_text.h): the terminal and the card print the same lines ----
 
-    // Screenshot, kept in the build folder for people to look at.
-    const fs::path shot = fs::path(IBLCHECK_BINARY_DIR) / "report_screenshot.png";
-    fs::remove(shot);
-    const int rc2 = run_chromium(f.root / "profile2",
-                                 fmt::format("--hide-scrollbars --window-size=1400,2000 --screenshot='{}'", shot.string()),
-                                 html, f.root / "shot.stdout", f.root / "shot.stderr");
-    ASSERT_EQ(rc2, 0) << slurp(f.root / "shot.stderr");
-    ASSERT_TRUE(fs::exists(shot)) << slurp(f.root / "shot.stderr");
-    EXPECT_GT(fs::file_size(shot), 30000u);
-    cv::Mat img = cv::imread(shot.string());
-    ASSERT_FALSE(img.empty());
-    EXPECT_EQ(img.cols, 1400);
-    EXPECT_EQ(img.rows, 2000);
-    cv::Scalar mean, stddev;
-    cv::meanStdDev(img, mean, stddev);
-    EXPECT_GT(stddev[0] + stddev[1] + stddev[2], 30.0) << "the screenshot looks blank";
-    const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    EXPECT_LT(secs, 30.0);
-    std::cout << "screenshot: " << shot.string() << " (" << secs << " s for both Chromium runs)\n";
+TEST(VerdictText, FailureSaysWhatWhereHowMuchAndHowToApprove) {
+    auto& f = testutil::small_run();
+    const json& t2 = f.results["tests"][1];
+    const std::vector<std::string> lines = report::verdict_details(t2);
+    const std::vector<std::string> want{
+        "baseline: flip.mean 0.0123 > 0.01 (+0.0023)",
+        "baseline: worst 16x16 block at (96,16) on metal r=0.3, mean FLIP 0.2",
+        "reference: accuracy.flip.mean 0.052 outside",
+        "reference: worst 16x16 block at (96,16) on metal r=0.3, mean FLIP 0.2",
+        "golden made with Mesa 22.3.5, this run Mesa 22.3.6",
+        "accuracy vs truth: 0.0300 -> 0.0520 (+73.3 %), band [0.0270, 0.0330]",
+        "approve: iblcheck bless --suite ci --filter 'mobile.roughness_sweep.studio.dominant_dir=lagarde'"};
+    EXPECT_EQ(lines, want);
+    EXPECT_TRUE(report::verdict_details(f.results["tests"][0]).empty()) << "a pass prints no details";
+    // An error prints its message; nothing to approve.
+    const auto err = report::verdict_details(f.results["tests"][4]);
+    ASSERT_EQ(err.size(), 1u);
+    EXPECT_EQ(err[0], "shader compile failed: prefilter.glsl:12: 'foo' : undeclared identifier");
+    // One line approves every failure (fail and missing-golden), globs joined by '|'.
+    EXPECT_EQ(report::rebless_all_line(f.results["tests"], "ci"),
+              "approve all 2 failures (after looking at them): iblcheck bless --suite 'ci' --filter "
+              "'mobile.roughness_sweep.studio.dominant_dir=lagarde|mobile.furnace.constant'");
+    EXPECT_EQ(report::rebless_all_line(json::array({f.results["tests"][0]}), "ci"), "");
 }

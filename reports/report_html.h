@@ -1,0 +1,80 @@
+// Internal to the report (report_writer.cpp, report_card.cpp, report_charts.cpp): lenient JSON
+// accessors (the results are validated before rendering), the image copier, and the pieces of the
+// page each file writes.
+#pragma once
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "reports/float_data.h"
+#include "reports/svg_chart.h"
+
+namespace iblcheck::report::html {
+
+using json = nlohmann::json;
+
+std::string str(const json& j, const char* k);
+std::optional<double> num(const json& j, const char* k);
+const json& sub(const json& j, const char* k);
+inline std::string e(std::string_view s) { return html_escape(s); }
+std::string value_text(const json& v);
+
+// fail, error, missing-golden, improved, pass: the order of the page.
+const std::vector<std::string>& verdict_order();
+int verdict_rank(const std::string& v);
+bool needs_bless(const std::string& v);
+
+// One colour per method (the charts and the tiles).
+std::string method_color(const std::string& method);
+
+// "t-3": the id of the test card at `i` in page order.
+std::string test_id(size_t i);
+// What differs between tests of one scene and environment: "mobile dominant_dir=lagarde".
+std::string test_label(const json& t);
+// The option key a variant changes ("dominant_dir"; "default" for none; "a+b" for several).
+std::string variant_family(const json& t);
+std::string short_message(const std::string& m);
+
+// Copies the images the page shows next to index.html (same relative paths) so the report folder
+// is self-contained; remembers the missing ones.
+class ImageStore {
+  public:
+    ImageStore(std::filesystem::path results_dir, std::filesystem::path out_dir);
+    // URL (relative to index.html) of the image, or nullopt when the file is missing.
+    std::optional<std::string> url(const std::string& rel);
+    const std::vector<std::string>& missing() const { return missing_; }
+    bool exists(const std::string& rel) const;
+
+  private:
+    std::filesystem::path results_dir_, out_dir_;
+    std::map<std::string, std::optional<std::string>> done_;
+    std::vector<std::string> missing_;
+    int external_ = 0;
+};
+
+struct Trend {
+    Sparkline flip, frame, cost;
+    std::string verdict_strip;
+    bool any = false;
+};
+
+struct PageContext {
+    ImageStore& images;
+    DataStore& data;
+};
+
+// A test's full card (<section class="test ...">): expanded for what needs a look, folded (hidden,
+// opened from its tile) for a pass.
+void test_card(std::string& o, const json& t, size_t idx, PageContext& ctx, const Trend& trend, bool expanded);
+// A passing test's thumbnail tile in the grid; clicking it opens the card.
+void test_tile(std::string& o, const json& t, size_t idx, PageContext& ctx);
+
+// The charts tab: cost against accuracy, wall time (median and range), error against roughness,
+// flicker against FLIP, each as small multiples. `order[i]` is the page index of tests[i].
+std::string charts_html(const std::vector<const json*>& tests, const std::vector<size_t>& order);
+
+} // namespace iblcheck::report::html

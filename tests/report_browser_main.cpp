@@ -1,0 +1,56 @@
+// report_browser: opens a report in headless Chromium (tests/browser.h), waits for its load check,
+// prints the page height and any error the page logged, and writes a screenshot. Used by
+// scripts/report_screenshots.sh for the screenshots committed under reports/screenshots/.
+//
+//   report_browser INDEX.html --out shot.png [--width 1440] [--height 900] [--full] [--tab charts]
+//
+// Exit 0, or 1 when the page logged an error or an image or data script failed to load.
+#include <CLI/CLI.hpp>
+#include <fmt/core.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "tests/browser.h"
+
+int main(int argc, char** argv) {
+    namespace fs = std::filesystem;
+    CLI::App app{"Screenshot an iblcheck report in headless Chromium"};
+    std::string index, out, tab;
+    int width = 1440, height = 900;
+    bool full = false;
+    app.add_option("index", index, "index.html of a report")->required()->check(CLI::ExistingFile);
+    app.add_option("--out", out, "PNG to write")->required();
+    app.add_option("--width", width, "viewport width, CSS pixels");
+    app.add_option("--height", height, "viewport height, CSS pixels");
+    app.add_option("--tab", tab, "tests (default), charts, history or table");
+    app.add_flag("--full", full, "the whole page, not the first screen");
+    CLI11_PARSE(app, argc, argv);
+    if (!iblcheck::testutil::Browser::available()) {
+        fmt::print(stderr, "{} is not installed (Debian package chromium)\n", iblcheck::testutil::Browser::kChromium);
+        return 2;
+    }
+    const fs::path profile = fs::temp_directory_path() / fmt::format("iblcheck_report_browser_{}", ::getpid());
+    int rc = 0;
+    {
+        iblcheck::testutil::Browser b(profile, width, height);
+        const std::string url = "file://" + fs::absolute(index).string() + (tab.empty() ? "" : "#" + tab);
+        b.open(url, "document.body && document.body.getAttribute('data-check') === 'done'", 60);
+        const auto facts = b.eval(
+            "({height: document.documentElement.scrollHeight, images: +document.body.getAttribute('data-images-failed'), "
+            "data: +document.body.getAttribute('data-data-failed'), viewers: +document.body.getAttribute('data-viewers-failed')})");
+        fmt::print("{}: page height {} px at {}x{}{}\n", index, facts["height"].get<int>(), width, height,
+                   tab.empty() ? "" : " (tab " + tab + ")");
+        for (const std::string& e : b.errors()) fmt::print("page error: {}\n", e);
+        if (facts["images"] != 0 || facts["data"] != 0 || facts["viewers"] != 0) {
+            fmt::print("failed to load: {} images, {} data scripts, {} viewers\n", facts["images"].get<int>(),
+                       facts["data"].get<int>(), facts["viewers"].get<int>());
+            rc = 1;
+        }
+        if (!b.errors().empty()) rc = 1;
+        std::ofstream(out, std::ios::binary) << b.screenshot(full);
+        fmt::print("screenshot: {}\n", out);
+    }
+    fs::remove_all(profile);
+    return rc;
+}
