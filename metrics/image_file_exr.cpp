@@ -4,9 +4,11 @@
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
 #include <ImfOutputFile.h>
+#include <half.h>
 
 #include <exception>
 #include <memory>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -86,9 +88,16 @@ void write_exr(const std::string& path, int width, int height, int channels, con
     try {
         Imf::OutputFile& out = *file;
         Imf::FrameBuffer fb;
-        const size_t xs = sizeof(float) * channels, ys = xs * width;
-        for (int c = 0; c < channels; ++c)
-            fb.insert(names[c], Imf::Slice(Imf::FLOAT, (char*)(data + c), xs, ys));
+        // OpenEXR converts pixel types when reading but not when writing: halves are rounded here
+        // (to nearest, Imath's conversion, as OpenImageIO did).
+        std::vector<Imath::half> halves;
+        if (half) halves.assign(data, data + size_t(width) * height * channels);
+        const size_t elem = half ? sizeof(Imath::half) : sizeof(float);
+        const size_t xs = elem * channels, ys = xs * width;
+        for (int c = 0; c < channels; ++c) {
+            char* base = half ? (char*)(halves.data() + c) : (char*)(data + c);
+            fb.insert(names[c], Imf::Slice(half ? Imf::HALF : Imf::FLOAT, base, xs, ys));
+        }
         out.setFrameBuffer(fb);
         out.writePixels(height);
     } catch (const std::exception& e) {
