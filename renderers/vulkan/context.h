@@ -1,6 +1,7 @@
 // The Vulkan plumbing, nothing IBL-specific: a headless instance and device (no window system),
 // device selection (lavapipe by default: deterministic and on every CI machine), validation with an
 // error counter, buffers/images, compute pipelines with push descriptors, and timestamp queries.
+// Graphics pipelines and offscreen MSAA targets are in graphics_pipeline.h.
 #pragma once
 #include <vulkan/vulkan.h>
 
@@ -33,6 +34,11 @@ struct DeviceInfo {
     bool shader_float16 = false;
     bool storage_16bit = false;
     bool int64_atomics = false; // shaderInt64 + shaderBufferInt64Atomics: instruction counting (spirv_cost.h)
+    bool graphics = false;      // the queue also runs graphics (graphics_pipeline.h)
+    // vertexPipelineStoresAndAtomics + fragmentStoresAndAtomics: counting instructions of a draw
+    bool graphics_stores = false;
+    bool standard_sample_locations = false;
+    VkSampleCountFlags color_sample_counts = 0, depth_sample_counts = 0; // framebuffer limits
     bool timestamps = false;
     double timestamp_period_ns = 1;
     bool validation = false;
@@ -192,9 +198,14 @@ class Context {
     // Debug-utils callback entry (public for the C callback).
     void on_validation_message(int severity, const char* message);
 
+    // Records vkCmdPushDescriptorSetKHR of `bindings` (set 0) for a pipeline of `bind_point`.
+    void push_descriptors(VkCommandBuffer cmd, VkPipelineBindPoint bind_point, VkPipelineLayout layout,
+                          const std::vector<Binding>& bindings) const;
+    // A memory type with `props` among `bits` (VkMemoryRequirements::memoryTypeBits); EnvironmentError if none.
+    uint32_t find_memory_type(uint32_t bits, VkMemoryPropertyFlags props) const;
+
   private:
     void destroy();
-    uint32_t find_memory_type(uint32_t bits, VkMemoryPropertyFlags props) const;
 
     DeviceInfo info_;
     VkInstance instance_ = VK_NULL_HANDLE;
@@ -209,7 +220,6 @@ class Context {
     int validation_errors_ = 0;
     std::vector<std::string> validation_messages_;
     PFN_vkCmdPushDescriptorSetKHR push_descriptor_fn_ = nullptr;
-    friend class ComputePipeline;
 };
 
 // Throws EnvironmentError when VkResult is not VK_SUCCESS, naming the call.
