@@ -6,6 +6,7 @@
 #include <set>
 
 #include "harness/common/errors.h"
+#include "renderers/option_table.h"
 #include "renderers/renderer.h"
 
 namespace fs = std::filesystem;
@@ -130,6 +131,14 @@ void parse_size(const Ctx& c, const json& j, const std::string& where, int& w, i
 
 } // namespace
 
+TestSpec temporal_reference_spec(const TestCase& tc) {
+    TestSpec ref = tc.spec;
+    ref.options.set("specular_aa", "off");
+    ref.options.set("ssaa", std::to_string(tc.temporal.reference_ssaa * ssaa_of(tc.spec.options)));
+    for (const auto& [k, v] : tc.temporal.reference_options.values()) ref.options.set(k, v);
+    return ref;
+}
+
 fs::path suite_dir() {
     if (const char* e = std::getenv("IBLCHECK_SUITE_DIR"); e && *e) return e;
     return fs::path(IBLCHECK_SOURCE_DIR) / "harness" / "suites";
@@ -251,11 +260,13 @@ Suite load_suite(const std::string& name_or_path) {
         if (t.contains("temporal")) {
             const json& tj = t["temporal"];
             std::string tw = w + ".temporal";
-            c.keys(tj, tw, {"frames", "reference_ssaa", "checks"});
+            c.keys(tj, tw, {"frames", "reference_ssaa", "reference_options", "checks"});
             if (!tj.contains("frames")) c.fail(tw + ".frames", "missing required key");
             proto.temporal.frames = int(c.num(tj["frames"], tw + ".frames"));
             if (proto.temporal.frames < 2 || proto.temporal.frames > 256) c.fail(tw + ".frames", "must be in 2..256");
             if (tj.contains("reference_ssaa")) proto.temporal.reference_ssaa = int(c.num(tj["reference_ssaa"], tw + ".reference_ssaa"));
+            if (tj.contains("reference_options"))
+                proto.temporal.reference_options = c.options(tj["reference_options"], tw + ".reference_options");
             if (tj.contains("checks")) {
                 const json& cj = tj["checks"];
                 c.keys(cj, tw + ".checks", {"flicker", "variation_ratio", "flip_mean", "flicker_ratio", "flip_ratio"});
@@ -281,6 +292,7 @@ Suite load_suite(const std::string& name_or_path) {
                 tc.name = tc.spec.method + "." + tc.spec.scene + "." + env + "." + tc.variant;
                 try {
                     validate_spec(tc.spec);
+                    if (tc.temporal.frames) validate_spec(temporal_reference_spec(tc));
                 } catch (const UsageError& e) {
                     c.fail(w, e.what());
                 }
