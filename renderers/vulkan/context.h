@@ -135,6 +135,12 @@ class ComputePipeline {
 
 // Timestamp queries around passes. begin(name)/end() pairs in one command buffer; results after
 // the submission completed.
+//
+// Each begin writes two bottom-of-pipe timestamps, the pass's and a marker after it. On lavapipe a
+// timestamp waits in llvmpipe's rasterizer bins whenever a framebuffer has been bound (any earlier
+// render pass in the process), and only a later non-top-of-pipe timestamp, which flushes, resolves
+// it: without the marker a begin timestamp would resolve after the pass, and every compute pass
+// timed after a draw read ~0 ms (measured: 0.01 ms for a 90 ms dispatch).
 class GpuTimer {
   public:
     GpuTimer(Context& ctx, uint32_t max_passes);
