@@ -183,3 +183,37 @@ TEST(ShaderCompiler, StageComesFromTheExtension) {
         EXPECT_NE(std::string(e.what()).find("wrong.vert"), std::string::npos) << e.what();
     }
 }
+
+TEST(GpuTimer, ComputePassAfterADrawIsTimedAroundTheDispatch) {
+    // On lavapipe a timestamp written after any render pass waits in llvmpipe's bins until a later
+    // flushing timestamp: the begin of a compute pass then resolved after the dispatch and a
+    // dispatch of tens of milliseconds read ~0.01 ms (context.h, GpuTimer). A draw, then a busy
+    // dispatch (4096 invocations x 20000 iterations: >= 10 ms on any CPU, longer under load).
+    Fixture f;
+    f.draw({Push{{1, 1, 1, 1}, 0.5f, 0xF, 0}});
+    fs::path p = temp_dir() / "busy.comp";
+    std::ofstream(p) << R"(#version 460
+layout(local_size_x = 64) in;
+layout(binding = 0, std430) buffer B { float v[]; } b;
+void main() {
+    float x = float(gl_GlobalInvocationID.x);
+    for (int i = 0; i < 20000; ++i) x = fract(x * 1.0001 + 0.37);
+    b.v[gl_GlobalInvocationID.x] = x;
+}
+)";
+    vk::ComputePipeline busy(context(), vk::compile_compute_shader_file(p), {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}, 0);
+    vk::Buffer out = context().create_buffer(4096 * 4);
+    std::vector<vk::Binding> b = {vk::Binding::storage_buffer(0, out)};
+    vk::GpuTimer timer(context(), 1);
+    context().submit([&](VkCommandBuffer cmd) {
+        timer.reset(cmd);
+        busy.warm_up(cmd, b, nullptr, 0);
+        timer.begin(cmd, "busy");
+        busy.dispatch(cmd, b, nullptr, 0, 64);
+        timer.end(cmd);
+    });
+    auto r = timer.results();
+    ASSERT_EQ(r.size(), 1u);
+    EXPECT_GT(r[0].second, 1.0) << "ms";
+    expect_no_validation_errors();
+}
