@@ -131,9 +131,15 @@ void parse_size(const Ctx& c, const json& j, const std::string& where, int& w, i
 
 } // namespace
 
+TestSpec without_specular_aa(TestSpec spec) {
+    spec.options.set("specular_aa", "off");
+    spec.options.erase("specular_aa_variance");
+    spec.options.erase("specular_aa_threshold");
+    return spec;
+}
+
 TestSpec temporal_reference_spec(const TestCase& tc) {
-    TestSpec ref = tc.spec;
-    ref.options.set("specular_aa", "off");
+    TestSpec ref = without_specular_aa(tc.spec);
     ref.options.set("ssaa", std::to_string(tc.temporal.reference_ssaa * ssaa_of(tc.spec.options)));
     for (const auto& [k, v] : tc.temporal.reference_options.values()) ref.options.set(k, v);
     return ref;

@@ -96,7 +96,10 @@ struct Suite {
     std::vector<TestCase> tests;
 };
 
-// The reference sequence of a temporal test: the test's spec with specular_aa=off and ssaa ×
+// `spec` with specular_aa=off and without the specular-AA parameters (which then select nothing),
+// so that the `off` and reference sequences of every variant of a scene are the same render.
+TestSpec without_specular_aa(TestSpec spec);
+// The reference sequence of a temporal test: without_specular_aa(the test's spec) with ssaa ×
 // reference_ssaa (renderers/option_table.h: ssaa_of), then the reference_options.
 TestSpec temporal_reference_spec(const TestCase& tc);
 

@@ -32,8 +32,7 @@ SequenceScore score_sequence(const std::vector<cv::Mat>& test, const std::vector
 TemporalOutcome run_temporal(const TestCase& tc, Worker& w, const fs::path& img_dir, const std::string& rel_dir,
                              int flip_threads) {
     const TemporalSpec& ts = tc.temporal;
-    TestSpec off = tc.spec, ref = temporal_reference_spec(tc);
-    off.options.set("specular_aa", "off");
+    TestSpec off = without_specular_aa(tc.spec), ref = temporal_reference_spec(tc);
     const auto& test_frames = w.sequence(tc.spec, ts.frames);
     const auto& off_frames = w.sequence(off, ts.frames);
     const auto& ref_frames = w.sequence(ref, ts.frames);
