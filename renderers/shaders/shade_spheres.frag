@@ -11,8 +11,8 @@
 #error "shade_spheres.frag and .vert are the shading=fragment pass (renderers/option_table.cpp)"
 #endif
 
-layout(location = 0) flat in vec4 camera_in[4];  // shade_spheres.vert
-layout(location = 4) flat in vec4 sphere_in[3];
+layout(location = 0) flat in CameraGpu cam;  // shade_spheres.vert
+layout(location = 4) flat in SphereGpu s;
 layout(location = 0) out vec4 color;  // rgb, alpha 1: the resolve averages it into coverage
 
 // Vulkan's standard locations for 4 samples (spec, "Multisampling"; the host checks
@@ -21,8 +21,6 @@ const vec2 SAMPLES_4X[4] = vec2[](vec2(0.375, 0.125), vec2(0.875, 0.375), vec2(0
 
 void main() {
     vec2 size = vec2(pc.width, pc.height);
-    CameraGpu cam = CameraGpu(camera_in[0], camera_in[1], camera_in[2], camera_in[3]);
-    SphereGpu s = SphereGpu(sphere_in[0], sphere_in[1], sphere_in[2]);
     vec2 corner = floor(gl_FragCoord.xy);
     // The pixel centre's surface (clamped to the silhouette where the centre misses) feeds the
     // derivatives, taken here in uniform control flow, before any discard: helper and edge pixels
