@@ -8,6 +8,7 @@
 #include <set>
 
 #include "harness/common/errors.h"
+#include "renderers/option_table.h"
 #include "renderers/renderer.h"
 
 namespace fs = std::filesystem;
@@ -131,6 +132,20 @@ void parse_size(const Ctx& c, const json& j, const std::string& where, int& w, i
 }
 
 } // namespace
+
+TestSpec without_specular_aa(TestSpec spec) {
+    spec.options.set("specular_aa", "off");
+    spec.options.erase("specular_aa_variance");
+    spec.options.erase("specular_aa_threshold");
+    return spec;
+}
+
+TestSpec temporal_reference_spec(const TestCase& tc) {
+    TestSpec ref = without_specular_aa(tc.spec);
+    ref.options.set("ssaa", std::to_string(tc.temporal.reference_ssaa * ssaa_of(tc.spec.options)));
+    for (const auto& [k, v] : tc.temporal.reference_options.values()) ref.options.set(k, v);
+    return ref;
+}
 
 fs::path suite_dir() {
     if (const char* e = std::getenv("IBLCHECK_SUITE_DIR"); e && *e) return e;
@@ -267,11 +282,13 @@ Suite load_suite(const std::string& name_or_path) {
         if (t.contains("temporal")) {
             const json& tj = t["temporal"];
             std::string tw = w + ".temporal";
-            c.keys(tj, tw, {"frames", "reference_ssaa", "checks"});
+            c.keys(tj, tw, {"frames", "reference_ssaa", "reference_options", "checks"});
             if (!tj.contains("frames")) c.fail(tw + ".frames", "missing required key");
             proto.temporal.frames = int(c.num(tj["frames"], tw + ".frames"));
             if (proto.temporal.frames < 2 || proto.temporal.frames > 256) c.fail(tw + ".frames", "must be in 2..256");
             if (tj.contains("reference_ssaa")) proto.temporal.reference_ssaa = int(c.num(tj["reference_ssaa"], tw + ".reference_ssaa"));
+            if (tj.contains("reference_options"))
+                proto.temporal.reference_options = c.options(tj["reference_options"], tw + ".reference_options");
             if (tj.contains("checks")) {
                 const json& cj = tj["checks"];
                 c.keys(cj, tw + ".checks", {"flicker", "variation_ratio", "flip_mean", "flicker_ratio", "flip_ratio"});
@@ -297,6 +314,7 @@ Suite load_suite(const std::string& name_or_path) {
                 tc.name = tc.spec.method + "." + tc.spec.scene + "." + env + "." + tc.variant;
                 try {
                     validate_spec(tc.spec);
+                    if (tc.temporal.frames) validate_spec(temporal_reference_spec(tc));
                 } catch (const UsageError& e) {
                     c.fail(w, e.what());
                 }

@@ -15,7 +15,8 @@
 //                "baseline": true, "reference": true,
 //                "baseline_tolerances": {...}, "reference_band": {...}, "max_cost_growth": 0.25, "tags": ["..."],
 //                "tolerance_note": "why this test's tolerances differ from the defaults (measured floors)",
-//                "temporal": {"frames": 32, "reference_ssaa": 8, "checks": {NAME: {"min": x, "max": y}}},
+//                "temporal": {"frames": 32, "reference_ssaa": 8, "reference_options": {k: v},
+//                             "checks": {NAME: {"min": x, "max": y}}},
 //                "stability": {"repeats": 2, "seeds": 3, "thread_counts": true, "min_margin": 3,
 //                              "fail_on_flaky": false, "cpu_caps": ["avx", "sse4.1"]} } ]
 //                                                 ("stability" may also sit in "defaults")
@@ -45,10 +46,13 @@ namespace iblcheck {
 // Temporal tests (animated scenes): every frame of the test, of the same scene with
 // specular_aa=off (the comparison) and of the reference sequence (the same shading, ssaa ×
 // reference_ssaa, specular_aa=off: a near-perfect pixel filter) is rendered and tone-mapped;
-// checks bound flicker, flip_mean and their ratios to the `off` sequence.
+// checks bound flicker, flip_mean and their ratios to the `off` sequence. reference_options
+// override the reference's options last (e.g. shading=compute: the fragment path's tests are
+// judged against the ray-traced, supersampled compute path).
 struct TemporalSpec {
     int frames = 0;                       // 0: not a temporal test
     int reference_ssaa = 8;
+    OptionMap reference_options;
     std::map<std::string, Bound> checks;  // flicker, variation_ratio, flip_mean, flicker_ratio, flip_ratio
 };
 
@@ -94,6 +98,13 @@ struct Suite {
     int timing_repeats = 1;          // renders per test whose frame times give a median and range
     std::vector<TestCase> tests;
 };
+
+// `spec` with specular_aa=off and without the specular-AA parameters (which then select nothing),
+// so that the `off` and reference sequences of every variant of a scene are the same render.
+TestSpec without_specular_aa(TestSpec spec);
+// The reference sequence of a temporal test: without_specular_aa(the test's spec) with ssaa ×
+// reference_ssaa (renderers/option_table.h: ssaa_of), then the reference_options.
+TestSpec temporal_reference_spec(const TestCase& tc);
 
 // Folder of suite files: <source>/harness/suites (IBLCHECK_SUITE_DIR overrides).
 std::filesystem::path suite_dir();

@@ -32,10 +32,7 @@ SequenceScore score_sequence(const std::vector<cv::Mat>& test, const std::vector
 TemporalOutcome run_temporal(const TestCase& tc, Worker& w, const fs::path& img_dir, const std::string& rel_dir,
                              int flip_threads) {
     const TemporalSpec& ts = tc.temporal;
-    TestSpec off = tc.spec, ref = tc.spec;
-    off.options.set("specular_aa", "off");
-    ref.options.set("specular_aa", "off");
-    ref.options.set("ssaa", std::to_string(ts.reference_ssaa * tc.spec.options.get_int("ssaa", 2)));
+    TestSpec off = without_specular_aa(tc.spec), ref = temporal_reference_spec(tc);
     const auto& test_frames = w.sequence(tc.spec, ts.frames);
     const auto& off_frames = w.sequence(off, ts.frames);
     const auto& ref_frames = w.sequence(ref, ts.frames);
@@ -49,7 +46,8 @@ TemporalOutcome run_temporal(const TestCase& tc, Worker& w, const fs::path& img_
          {"flip_mean", st.flip_mean},
          {"off", {{"flicker", so.flicker}, {"variation_ratio", so.variation_ratio}, {"flip_mean", so.flip_mean}}},
          {"flicker_ratio", so.flicker > 0 ? st.flicker / so.flicker : 1.0},
-         {"flip_ratio", so.flip_mean > 0 ? st.flip_mean / so.flip_mean : 1.0}};
+         {"flip_ratio", so.flip_mean > 0 ? st.flip_mean / so.flip_mean : 1.0},
+         {"reference", {{"method", ref.method}, {"options", ref.options.canonical()}}}};
     j["checks"] = json::array();
     for (auto& [metric, bound] : ts.checks) {
         Check c = judge_bound("temporal." + metric, j[metric].get<double>(), bound);

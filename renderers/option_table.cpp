@@ -20,10 +20,14 @@ const std::vector<OptionInfo>& option_catalog() {
         {"roughness_bias", "0", "-1..1", "all", "", "stability: added to every sphere's roughness"},
         {"camera_shift", "0", "pixels x,y,0", "all", "", "stability: moves the camera by a fraction of a pixel"},
         {"bump_frequency", "200", ">0", "all", "", "spatial frequency of the bumpy_sphere normal detail (radius-1 units)"},
-        {"ssaa", "2", "1..16", "mobile,sampled", "", "n x n rays per pixel (silhouettes)"},
+        {"ssaa", "2 (shading=fragment: 1)", "1..16", "mobile,sampled", "",
+         "n x n rays per pixel (silhouettes); shading=fragment: renders n x n times the pixels and averages them"},
         {"cube_size", "128 (sampled: 256)", "8..2048, power of two", "mobile,sampled", "", "base size of the cubemaps"},
         {"mips", "7", "1..log2(cube_size)+1", "mobile", "", "levels of the prefiltered chain"},
         {"prefilter_samples", "64", "1..65536", "mobile", "", "GGX samples per prefiltered texel"},
+        {"shading", "compute", "compute|fragment", "mobile", "SHADING",
+         "compute: each pixel ray-traces the spheres, specular AA from neighbouring rays; fragment: sphere impostors "
+         "in a graphics pipeline, MSAA 4x, specular AA from the hardware quads' dFdx/dFdy"},
         {"mip_mapping", "ue4", "ue4|filament|origin", "mobile", "MIP_MAPPING", "roughness <-> mip mapping"},
         {"env_brdf", "approx", "approx|lut", "mobile", "ENV_BRDF", "EnvBRDFApprox (Karis/Lazarov) or a DFG LUT pass"},
         {"lut_size", "64", "8..512", "mobile", "", "DFG LUT resolution (env_brdf=lut)"},
@@ -130,6 +134,8 @@ std::map<std::string, std::string> shader_selections(const OptionMap& o, const s
         if (!info.glsl_define.empty() && info.read_by(method)) out[info.key] = option_choice(o, info.key);
     return out;
 }
+
+int ssaa_of(const OptionMap& o) { return o.get_int("ssaa", option_choice(o, "shading") == "fragment" ? 1 : 2); }
 
 std::map<std::string, std::string> glsl_selection_names(const std::map<std::string, std::string>& selections) {
     std::map<std::string, std::string> out;

@@ -53,6 +53,10 @@ std::map<std::string, std::string> glsl_defines(const std::map<std::string, std:
 // For every option with a define that `method` reads: key -> the value in `o` (or the default).
 std::map<std::string, std::string> shader_selections(const OptionMap& o, const std::string& method);
 
+// The ssaa a mobile render uses: the option, else 2 for shading=compute (rays per pixel) and 1 for
+// shading=fragment (supersampling factor; MSAA covers silhouettes).
+int ssaa_of(const OptionMap& o);
+
 // The selections alone as DEFINE = value name (e.g. "STORAGE": "STORAGE_RGBA16F"): what the
 // results record as the shader variant.
 std::map<std::string, std::string> glsl_selection_names(const std::map<std::string, std::string>& selections);

@@ -425,10 +425,10 @@ TEST(MobileCost, ShadingTwiceDoublesTheCountAndARunawayLoopMultipliesIt) {
     fs::remove_all(dir);
     fs::create_directories(dir);
     fs::copy(fs::path(IBLCHECK_SOURCE_DIR) / "renderers/shaders", dir / "shaders", fs::copy_options::recursive);
-    const fs::path file = dir / "shaders/shade_spheres.comp";
-    const std::string original = read_text(file);
-    auto edited = [&](const std::string& from, const std::string& to) {
-        std::string text = original;
+    // The compute pass and the shading it shares with the fragment path (split_sum.glsl).
+    const fs::path pass = dir / "shaders/shade_spheres.comp", shading = dir / "shaders/split_sum.glsl";
+    auto edited = [&](const fs::path& file, const std::string& from, const std::string& to) {
+        std::string text = read_text(file);
         size_t at = text.find(from);
         EXPECT_NE(at, std::string::npos) << from;
         if (at != std::string::npos) text.replace(at, from.size(), to);
@@ -456,7 +456,8 @@ TEST(MobileCost, ShadingTwiceDoublesTheCountAndARunawayLoopMultipliesIt) {
     };
 
     // Every ray shaded twice and averaged: 0.5 * (a + a) == a exactly.
-    edited("for (uint i = 0u; i < n; ++i) sum += shade_ray(vec2(px) + (vec2(i, j) + 0.5) / float(n));",
+    const std::string pass_original = read_text(pass);
+    edited(pass, "for (uint i = 0u; i < n; ++i) sum += shade_ray(vec2(px) + (vec2(i, j) + 0.5) / float(n));",
            "for (uint i = 0u; i < n; ++i) {\n"
            "            vec2 p = vec2(px) + (vec2(i, j) + 0.5) / float(n);\n"
            "            sum += 0.5 * (shade_ray(p) + shade_ray(p));\n"
@@ -468,11 +469,12 @@ TEST(MobileCost, ShadingTwiceDoublesTheCountAndARunawayLoopMultipliesIt) {
     EXPECT_GE(factor, 1.9) << twice.shader_instructions_per_pixel << " vs " << base.shader_instructions_per_pixel;
     EXPECT_LT(factor, 2.0);  // the per-pixel loop and the store are not doubled
 
-    // A runaway loop in shade_ray whose result is multiplied by 0 (what issue 14 saw pass).
-    edited("    return vec4(vec3(diffuse + specular), 1.0);\n}",
+    // A runaway loop in the shading whose result is multiplied by 0 (what issue 14 saw pass).
+    std::ofstream(pass) << pass_original;
+    edited(shading, "    return vec3(diffuse + specular);\n}",
            "    float waste = 0.0;\n"
            "    for (uint k = 0u; k < 2500u; ++k) waste += sin(float(k) * roughness);\n"
-           "    return vec4(vec3(diffuse + specular), 1.0) + vec4(0.0) * waste;\n}");
+           "    return vec3(diffuse + specular) + vec3(0.0) * waste;\n}");
     RenderResult runaway = render_modified(small);
     EXPECT_TRUE(identical(runaway.image, base_small.image));
     double runaway_factor = runaway.shader_instructions_per_pixel / base_small.shader_instructions_per_pixel;

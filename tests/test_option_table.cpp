@@ -116,7 +116,7 @@ TEST(OptionTable, EveryNonDefaultShaderValueHasShaderCode) {
 TEST(OptionTable, AShaderWithoutItsDefineDoesNotCompile) {
     auto defs = glsl_defines(shader_selections(OptionMap{}, "mobile"));
     EXPECT_NO_THROW(vk::compile_compute_shader("shade_spheres.comp", defs));
-    for (const char* define : {"STORAGE", "SPECULAR_AA", "PRECISION"}) {
+    for (const char* define : {"STORAGE", "SPECULAR_AA", "PRECISION", "SHADING"}) {
         auto missing = defs;
         missing.erase(define);
         try {
@@ -130,13 +130,34 @@ TEST(OptionTable, AShaderWithoutItsDefineDoesNotCompile) {
 }
 
 TEST(OptionTable, EveryValueOfEveryShaderOptionCompiles) {
-    for (const auto& info : option_catalog()) {
-        if (info.glsl_define.empty() || !info.read_by("mobile")) continue;
-        for (const auto& value : info.choices()) {
-            OptionMap o;
-            o.set(info.key, value);
-            auto defs = glsl_defines(shader_selections(o, "mobile"));
-            EXPECT_NO_THROW(vk::compile_compute_shader("shade_spheres.comp", defs)) << info.key << "=" << value;
+    // In both shading paths: shade_spheres.comp, or shade_spheres.vert + .frag (issue 18).
+    for (std::string shading : option_info("shading").choices())
+        for (const auto& info : option_catalog()) {
+            if (info.glsl_define.empty() || !info.read_by("mobile")) continue;
+            for (const auto& value : info.choices()) {
+                OptionMap o;
+                o.set("shading", shading);
+                o.set(info.key, value);
+                auto defs = glsl_defines(shader_selections(o, "mobile"));
+                std::string what = info.key + "=" + value + " shading=" + option_choice(o, "shading");
+                if (option_choice(o, "shading") == "fragment") {
+                    EXPECT_NO_THROW(vk::compile_shader("shade_spheres.vert", defs)) << what;
+                    EXPECT_NO_THROW(vk::compile_shader("shade_spheres.frag", defs)) << what;
+                } else {
+                    EXPECT_NO_THROW(vk::compile_compute_shader("shade_spheres.comp", defs)) << what;
+                }
+            }
         }
-    }
+}
+
+TEST(OptionTable, EachShadingPathRefusesTheOthersDefine) {
+    // The host picks the pass from the same table value the shaders test: a mismatch is a compile
+    // error naming the option table, never the other path's code running silently.
+    OptionMap fragment;
+    fragment.set("shading", "fragment");
+    auto frag_defs = glsl_defines(shader_selections(fragment, "mobile"));
+    auto comp_defs = glsl_defines(shader_selections(OptionMap{}, "mobile"));
+    EXPECT_THROW(vk::compile_compute_shader("shade_spheres.comp", frag_defs), ShaderCompileError);
+    EXPECT_THROW(vk::compile_shader("shade_spheres.frag", comp_defs), ShaderCompileError);
+    EXPECT_THROW(vk::compile_shader("shade_spheres.vert", comp_defs), ShaderCompileError);
 }

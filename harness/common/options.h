@@ -23,6 +23,7 @@ class OptionMap {
     // Parses "key=value"; throws UsageError on a missing '='.
     void set_from_string(const std::string& kv);
     void set(const std::string& key, const std::string& value) { values_[key] = value; }
+    void erase(const std::string& key) { values_.erase(key); }
     bool has(const std::string& key) const { return values_.count(key) != 0; }
 
     std::string get_string(const std::string& key, const std::string& def) const;

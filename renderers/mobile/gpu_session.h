@@ -1,11 +1,13 @@
-// What a process keeps between renders on the GPU: the Vulkan context and the compute pipelines,
-// cached by shader name + defines (creating a pipeline makes lavapipe compile LLVM, ~0.1 s each).
+// What a process keeps between renders on the GPU: the Vulkan context and the compute and graphics
+// pipelines, cached by shader name + defines (creating a pipeline makes lavapipe compile LLVM,
+// ~0.1 s each).
 #pragma once
 #include <map>
 #include <memory>
 #include <string>
 
 #include "renderers/vulkan/context.h"
+#include "renderers/vulkan/graphics_pipeline.h"
 
 namespace iblcheck {
 
@@ -20,6 +22,12 @@ class GpuSession {
     const vk::ComputePipeline& pipeline(const std::string& shader, const vk::Defines& defines,
                                         const std::vector<VkDescriptorType>& bindings, uint32_t push_bytes,
                                         const vk::CompileOptions& options = {});
+    // The graphics pipeline of `vertex` + `fragment` (both compiled with `defines` and `options`)
+    // drawing into targets of `target`'s format.
+    const vk::GraphicsPipeline& graphics_pipeline(const std::string& vertex, const std::string& fragment,
+                                                  const vk::Defines& defines, const std::vector<VkDescriptorType>& bindings,
+                                                  uint32_t push_bytes, const vk::TargetFormat& target,
+                                                  const vk::CompileOptions& options = {});
     // A per-session cache of anything built on the device (the precompute passes' results, keyed by
     // environment hash + settings): an animated sequence re-renders the same environment per frame.
     template <class T> std::shared_ptr<T> cached(const std::string& key) {
@@ -34,6 +42,7 @@ class GpuSession {
   private:
     std::unique_ptr<vk::Context> ctx_;
     std::map<std::string, std::unique_ptr<vk::ComputePipeline>> pipelines_;
+    std::map<std::string, std::unique_ptr<vk::GraphicsPipeline>> graphics_pipelines_;
     std::map<std::string, std::string> shader_hashes_;
     std::map<std::string, std::shared_ptr<void>> cache_;
 };

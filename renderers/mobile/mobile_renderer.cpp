@@ -8,6 +8,7 @@
 #include "renderers/option_table.h"
 #include "ibl_precompute.h"
 #include "renderers/scenes/scene.h"
+#include "fragment_shading.h"
 #include "shading_cost.h"
 #include "renderers/vulkan/fp16_emulation.h"
 
@@ -54,28 +55,25 @@ RenderResult render_mobile(GpuSession& gpu, const Environment& env, const TestSp
 
     vk::Defines defs = storage_defines(ps, ibl.native_r11g11b10);
     defs.merge(glsl_defines(variant));  // keeps storage_defines' entries; adds the other selections
-    const std::vector<VkDescriptorType> types = {kStorageBuffer, kSampled, kStorageBuffer, kSampled, kSampled, kStorageBuffer};
-    const auto& shade = gpu.pipeline("shade_spheres.comp", defs, types, 48, shade_options);
+    const bool fragment = variant.at("shading") == "fragment";
 
     vk::Context& ctx = gpu.ctx();
     vk::Buffer scene_buf = upload_scene(ctx, scene);
-    vk::Buffer out = ctx.create_buffer(VkDeviceSize(width) * height * 16);
     std::string indirect = o.get_string("indirect_irradiance", "sh9");
-    struct {
-        uint32_t width, height, ssaa;
-        float full_mips, max_lod, mix_begin, mix_end, mix_largest, indirect, aa_variance, aa_threshold, rot;
-    } pc{uint32_t(width),
-         uint32_t(height),
-         uint32_t(o.get_int("ssaa", 2)),
-         float(ibl.full_mips),
-         float(std::min(ps.mips, ibl.full_mips) - 1),
-         float(o.get_double("mix_begin_roughness", 0.1)),
-         float(o.get_double("mix_end_roughness", 0.3)),
-         float(o.get_double("mix_largest_weight", 10000.0)),
-         indirect == "sh9" ? -1.0f : float(o.get_double("indirect_irradiance", 0)),
-         float(o.get_double("specular_aa_variance", 0.25)),
-         float(o.get_double("specular_aa_threshold", 0.18)),
-         ps.env_rotation_deg};
+    // ssaa: rays per pixel (compute) or the supersampling factor (fragment, default 1: a phone
+    // renders at its resolution and relies on MSAA at silhouettes).
+    ShadePush pc{uint32_t(width),
+                 uint32_t(height),
+                 uint32_t(ssaa_of(o)),
+                 float(ibl.full_mips),
+                 float(std::min(ps.mips, ibl.full_mips) - 1),
+                 float(o.get_double("mix_begin_roughness", 0.1)),
+                 float(o.get_double("mix_end_roughness", 0.3)),
+                 float(o.get_double("mix_largest_weight", 10000.0)),
+                 indirect == "sh9" ? -1.0f : float(o.get_double("indirect_irradiance", 0)),
+                 float(o.get_double("specular_aa_variance", 0.25)),
+                 float(o.get_double("specular_aa_threshold", 0.18)),
+                 ps.env_rotation_deg};
     if (pc.ssaa < 1 || pc.ssaa > 16) throw UsageError("option 'ssaa' must be in 1..16");
     if (pc.mix_end <= pc.mix_begin) throw UsageError("option 'mix_end_roughness' must exceed 'mix_begin_roughness'");
 
@@ -83,24 +81,37 @@ RenderResult render_mobile(GpuSession& gpu, const Environment& env, const TestSp
                                   vk::Binding::sampled_image(1, ibl.prefiltered.sampled_view, ctx.linear_sampler()),
                                   vk::Binding::storage_buffer(2, ibl.sh),
                                   vk::Binding::sampled_image(3, ibl.lut.sampled_view, ctx.linear_sampler()),
-                                  vk::Binding::sampled_image(4, ibl.irradiance.sampled_view, ctx.linear_sampler()),
-                                  vk::Binding::storage_buffer(5, out)};
-    vk::GpuTimer timer(ctx, 1);
-    ctx.submit([&](VkCommandBuffer cmd) {
-        timer.reset(cmd);
-        shade.warm_up(cmd, b, &pc, sizeof pc);
-        timer.begin(cmd, "shade_spheres");
-        shade.dispatch(cmd, b, &pc, sizeof pc, (width + 7) / 8, (height + 7) / 8, 1);
-        timer.end(cmd);
-        ctx.barrier(cmd);
-    });
-    for (auto& [name, ms] : timer.results()) result.timings.push_back({name, ms, true, false});
-    double coverage = read_back_image(out, width, height, result.image);
-    // Texture samples per pixel: one prefiltered-cube read per ray that hits, plus the LUT and the
-    // irradiance cube when used (SH9 is arithmetic).
+                                  vk::Binding::sampled_image(4, ibl.irradiance.sampled_view, ctx.linear_sampler())};
+    // Texture samples per shading: one prefiltered-cube read, plus the LUT and the irradiance
+    // cube when used (SH9 is arithmetic).
     double per_hit = 1.0 + (ps.lut ? 1.0 : 0.0) + (ps.irradiance_cube ? 1.0 : 0.0);
-    result.texture_fetches_per_pixel = coverage * pc.ssaa * pc.ssaa * per_hit;
-    auto instructions = shading_instructions_per_pixel(gpu, {"shade_spheres.comp", defs, types, shade_options, b, 5, &pc, sizeof pc, width, height}, out);
+    std::optional<double> instructions;
+    if (fragment) {
+        FragmentShadingResult f = shade_fragment(gpu, {defs, shade_options, b, pc, uint32_t(scene.spheres.size())});
+        result.image = f.image;
+        result.timings.insert(result.timings.end(), f.timings.begin(), f.timings.end());
+        result.texture_fetches_per_pixel = f.shaded_fragments_per_pixel * per_hit;
+        instructions = f.instructions_per_pixel;
+    } else {
+        const std::vector<VkDescriptorType> types = {kStorageBuffer, kSampled, kStorageBuffer, kSampled, kSampled, kStorageBuffer};
+        const auto& shade = gpu.pipeline("shade_spheres.comp", defs, types, 48, shade_options);
+        vk::Buffer out = ctx.create_buffer(VkDeviceSize(width) * height * 16);
+        b.push_back(vk::Binding::storage_buffer(5, out));
+        vk::GpuTimer timer(ctx, 1);
+        ctx.submit([&](VkCommandBuffer cmd) {
+            timer.reset(cmd);
+            shade.warm_up(cmd, b, &pc, sizeof pc);
+            timer.begin(cmd, "shade_spheres");
+            shade.dispatch(cmd, b, &pc, sizeof pc, (width + 7) / 8, (height + 7) / 8, 1);
+            timer.end(cmd);
+            ctx.barrier(cmd);
+        });
+        for (auto& [name, ms] : timer.results()) result.timings.push_back({name, ms, true, false});
+        double coverage = read_back_image(out, width, height, result.image);
+        // One shading per ray that hits.
+        result.texture_fetches_per_pixel = coverage * pc.ssaa * pc.ssaa * per_hit;
+        instructions = shading_instructions_per_pixel(gpu, {"shade_spheres.comp", defs, types, shade_options, b, 5, &pc, sizeof pc, width, height}, out);
+    }
     result.shader_instructions_per_pixel = instructions.value_or(0);
     result.provenance = {{"method", "mobile"},
                          {"cost", cost_provenance(instructions, result.texture_fetches_per_pixel)},
@@ -110,6 +121,13 @@ RenderResult render_mobile(GpuSession& gpu, const Environment& env, const TestSp
                          {"storage_native", ps.storage != "r11g11b10" || ibl.native_r11g11b10},
                          {"shader_variant", glsl_selection_names(variant)}};
     if (fp16_path) result.provenance["fp16"] = vk::fp16_path_name(*fp16_path);
+    if (fragment) {
+        // What the cost counts differs from compute's: renderers/mobile/fragment_shading.h.
+        result.provenance["fragment"] = {{"msaa_samples", 4},
+                                         {"ssaa", pc.ssaa},
+                                         {"shaded_fragments_per_pixel", result.texture_fetches_per_pixel / per_hit},
+                                         {"instructions_counted", "vertex and fragment invocations; helper invocations excluded"}};
+    }
     return result;
 }
 

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 
 namespace iblcheck {
@@ -139,6 +140,57 @@ Scene build_bumpy_sphere(const OptionMap& o) {
     return s;
 }
 
+// A field of small, smooth, low-roughness spheres drifting by sub-pixel steps (temporal suite,
+// issue 18): geometric specular AA's own case (Tokuyoshi & Kaplanyan 2019), where the normal's
+// curvature, not normal detail, packs the highlight into less than a pixel and moving geometry
+// makes it crawl and blink. 8x8 spheres of radius 3.5 px on a 20 px grid at the default 128x128
+// (pixel = 1/64 world unit), each with its own sub-pixel start offset and a drift of 0.30-0.45 px a
+// frame along a 20° diagonal (so both axes move by fractions of a pixel); the grid reaches 80 px
+// left of and above the view so drifting spheres keep it filled for 32+ frames.
+constexpr int kFieldGrid = 8;
+constexpr float kFieldPixel = 1.0f / 64.0f;    // world units per pixel at 128x128, half-height 1
+constexpr float kFieldRadiusPx = 3.5f;
+constexpr float kFieldSpacingPx = 20.0f;
+constexpr float kFieldDriftDeg = 20.0f;
+
+// A deterministic value in [0, 1) per (index, salt) (PCG hash, Jarzynski & Olano 2020): integer
+// arithmetic only, so every machine builds the same field.
+float field_hash(uint32_t i, uint32_t salt) {
+    uint32_t state = (i * 0x9E3779B9u + salt) * 747796405u + 2891336453u;
+    uint32_t word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+    return float(((word >> 22u) ^ word) >> 8) / 16777216.0f;
+}
+
+Scene build_sphere_field(const OptionMap& o) {
+    Scene s;
+    s.name = "sphere_field";
+    s.width = s.height = 128;
+    s.camera.half_height = 1.0f;
+    Material m;
+    m.roughness = float(o.get_double("roughness", 0.05));
+    m.metallic = float(o.get_double("metallic", 1.0));
+    m.base_color = o.get_vec3("base_color", {0.95f, 0.93f, 0.88f});
+    if (m.roughness < 0 || m.roughness > 1)
+        throw UsageError("option 'roughness': " + o.get_string("roughness", "") + " is outside [0, 1]");
+    const float frame = float(o.get_int("frame", 0));
+    const float dx = std::cos(kFieldDriftDeg * 3.14159265f / 180.0f), dy = std::sin(kFieldDriftDeg * 3.14159265f / 180.0f);
+    for (int j = 0; j < kFieldGrid; ++j)
+        for (int i = 0; i < kFieldGrid; ++i) {
+            uint32_t k = uint32_t(j * kFieldGrid + i);
+            float speed = 0.30f + 0.15f * field_hash(k, 1);  // px per frame
+            // Pixel position (x right, y down, relative to the view centre) at this frame.
+            float px = -80.0f + kFieldSpacingPx * float(i) + field_hash(k, 2) + speed * frame * dx;
+            float py = -80.0f + kFieldSpacingPx * float(j) + field_hash(k, 3) + speed * frame * dy;
+            Sphere sp;
+            sp.center = {px * kFieldPixel, -py * kFieldPixel, 0};
+            sp.radius = kFieldRadiusPx * kFieldPixel;
+            sp.material = m;
+            s.spheres.push_back(sp);
+            s.labels.push_back("field " + std::to_string(i) + "," + std::to_string(j) + " r=" + fmt_r(m.roughness));
+        }
+    return s;
+}
+
 const std::vector<SceneDef>& defs() {
     static const std::vector<SceneDef> d = {
         {"sphere",
@@ -167,6 +219,11 @@ const std::vector<SceneDef>& defs() {
          "amplitude 0.0008, frequency 200, phase +0.9 rad per frame; options frame=N, bump_amplitude, bump_frequency). "
          "Defaults roughness 0.05, metallic 1: the low-roughness case where specular highlights sparkle and crawl.",
          build_bumpy_sphere},
+        {"sphere_field",
+         "128x128: 8x8 smooth spheres of radius 3.5 px on a 20 px grid, drifting 0.30-0.45 px a frame along a 20 degree "
+         "diagonal (option frame=N), each from its own sub-pixel offset. Defaults roughness 0.05, metallic 1: "
+         "sub-pixel highlights from curvature alone, geometric specular AA's case (temporal suite).",
+         build_sphere_field},
     };
     return d;
 }

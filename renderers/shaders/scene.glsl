@@ -9,6 +9,14 @@ struct SphereGpu {
     vec4 roughness_bump;   // roughness, bump amplitude, bump frequency, bump phase
 };
 
+// The camera as scene_camera() returns it (the first four vec4 of SceneBuffer).
+struct CameraGpu {
+    vec4 eye_ortho;       // xyz eye, w: 1 orthographic, 0 perspective
+    vec4 forward_half_h;  // xyz forward, w: orthographic half height
+    vec4 right_tan_half;  // xyz right, w: tan(fov_y / 2)
+    vec4 up_pad;          // xyz up
+};
+
 layout(binding = 0, std430) readonly buffer SceneBuffer {
     vec4 eye_ortho;       // xyz eye, w: 1 orthographic, 0 perspective
     vec4 forward_half_h;  // xyz forward, w: orthographic half height
@@ -18,22 +26,25 @@ layout(binding = 0, std430) readonly buffer SceneBuffer {
     SphereGpu spheres[];
 } scene;
 
+CameraGpu scene_camera() { return CameraGpu(scene.eye_ortho, scene.forward_half_h, scene.right_tan_half, scene.up_pad); }
+
 // scene.h: ndc = (2·px/W − 1, 1 − 2·py/H); orthographic: parallel rays from the image plane,
 // perspective: from the eye.
-void camera_ray(vec2 p, vec2 size, out vec3 origin, out vec3 dir) {
+void camera_ray_of(CameraGpu cam, vec2 p, vec2 size, out vec3 origin, out vec3 dir) {
     vec2 ndc = vec2(2.0 * p.x / size.x - 1.0, 1.0 - 2.0 * p.y / size.y);
     float aspect = size.x / size.y;
-    vec3 f = scene.forward_half_h.xyz, r = scene.right_tan_half.xyz, u = scene.up_pad.xyz;
-    if (scene.eye_ortho.w > 0.5) {
-        float hh = scene.forward_half_h.w;
-        origin = scene.eye_ortho.xyz + r * (ndc.x * hh * aspect) + u * (ndc.y * hh);
+    vec3 f = cam.forward_half_h.xyz, r = cam.right_tan_half.xyz, u = cam.up_pad.xyz;
+    if (cam.eye_ortho.w > 0.5) {
+        float hh = cam.forward_half_h.w;
+        origin = cam.eye_ortho.xyz + r * (ndc.x * hh * aspect) + u * (ndc.y * hh);
         dir = f;
     } else {
-        float th = scene.right_tan_half.w;
-        origin = scene.eye_ortho.xyz;
+        float th = cam.right_tan_half.w;
+        origin = cam.eye_ortho.xyz;
         dir = normalize(f + r * (ndc.x * th * aspect) + u * (ndc.y * th));
     }
 }
+void camera_ray(vec2 p, vec2 size, out vec3 origin, out vec3 dir) { camera_ray_of(scene_camera(), p, size, origin, dir); }
 
 // Nearest hit in front of the origin; returns the sphere index or −1.
 int intersect_scene(vec3 o, vec3 d, out float t_hit) {

@@ -1,52 +1,17 @@
 #version 460
-// Pass 5: per-frame shading of the mobile split-sum pipeline. Each pixel traces ssaa×ssaa rays
-// against the analytic spheres (exact normals) and shades every hit with
-//   color = (1 − m)·c·E(n)/π  +  prefiltered(dir, lod(r)) · (F0·A + B) · normalisation
-// (Karis 2013, "Real Shading in Unreal Engine 4", split-sum approximation, eq. 3). Variants are
-// defines from the option table (renderers/option_table.cpp).
-#include "common.glsl"
-#include "scene.glsl"
-#include "mip_mapping.glsl"
-#include "storage.glsl"
-#include "precision.glsl"
-#include "env_brdf.glsl"
-#include "dominant_dir.glsl"
-#include "mobile_normalization.glsl"
-#include "sh9.glsl"
+// Pass 5, shading=compute: per-frame shading of the mobile split-sum pipeline. Each pixel traces
+// ssaa×ssaa rays against the analytic spheres (exact normals) and shades every hit with the
+// split sum (split_sum.glsl, shared with the fragment path shade_spheres.frag). Specular AA takes
+// its derivatives from neighbouring pixels' rays (specular_aa.glsl). Variants are defines from
+// the option table (renderers/option_table.cpp).
+#include "split_sum.glsl"
 #include "specular_aa.glsl"
-
-#ifndef DIFFUSE
-#error "DIFFUSE is set from the option table (renderers/option_table.cpp)"
+#if SHADING != SHADING_COMPUTE
+#error "shade_spheres.comp is the shading=compute pass (renderers/option_table.cpp)"
 #endif
 
 layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;
-layout(binding = 1) uniform samplerCube prefiltered;
-layout(binding = 2, std430) readonly buffer SH { vec4 coeffs[10]; } sh;
-layout(binding = 3) uniform sampler2D dfg_lut;
-layout(binding = 4) uniform samplerCube irradiance_cube;
 layout(binding = 5, std430) writeonly buffer Out { vec4 pixels[]; } out_image;
-layout(push_constant) uniform Push {
-    uint width;
-    uint height;
-    uint ssaa;
-    float full_mips;
-    float max_lod;
-    float mix_begin_roughness;
-    float mix_end_roughness;
-    float mix_largest_weight;
-    float indirect_irradiance;    // < 0: from SH9 at n
-    float specular_aa_variance;   // Tokuyoshi & Kaplanyan σ² scale
-    float specular_aa_threshold;  // κ clamp
-    float env_rotation_deg;       // unused here (baked into the cube); kept for layout parity
-} pc;
-
-vec3 diffuse_radiance(vec3 n) {
-#if DIFFUSE == DIFFUSE_IRRADIANCE_CUBE
-    return textureLod(irradiance_cube, n, 0.0).rgb;
-#else
-    return sh9_eval(sh.coeffs, n);
-#endif
-}
 
 // Shades one camera ray; returns rgb and 1 in alpha for a hit, 0 for a miss.
 vec4 shade_ray(vec2 p) {
@@ -54,37 +19,9 @@ vec4 shade_ray(vec2 p) {
     vec3 n, v;
     if (!surface_at(p, vec2(pc.width, pc.height), id, n, v)) return vec4(0.0);
     SphereGpu s = scene.spheres[id];
-    vec3 base = s.base_color_metallic.rgb;
-    float metallic = s.base_color_metallic.a;
     float roughness = specular_aa_roughness(s.roughness_bump.x, n, v, p, vec2(pc.width, pc.height),
                                             pc.specular_aa_variance, pc.specular_aa_threshold);
-
-    vec3 diffuse_light = diffuse_radiance(n);
-
-    hvec3 hn = hvec3(n), hv = hvec3(v);
-    hfloat hr = hfloat(roughness);
-    hfloat n_dot_v = max(dot(hn, hv), hfloat(1e-4));
-    hvec3 refl = hfloat(2.0) * dot(hn, hv) * hn - hv;
-    vec3 dir = vec3(specular_dominant_dir(hn, refl, hr));
-    float lod = roughness_to_lod(roughness, pc.full_mips, pc.max_lod);
-    hvec3 spec_light = hvec3(decode_storage(textureLod(prefiltered, dir, lod)));
-
-#if ENV_BRDF == ENV_BRDF_LUT
-    hvec2 ab = hvec2(textureLod(dfg_lut, dfg_lut_uv(float(n_dot_v), roughness, float(textureSize(dfg_lut, 0).x)), 0.0).rg);
-#else
-    hvec2 ab = env_brdf_approx(hr, n_dot_v);
-#endif
-    hvec3 f0 = mix(hvec3(0.04), hvec3(base), hfloat(metallic));
-    hvec3 specular = spec_light * (f0 * ab.x + ab.y);
-
-    hfloat indirect = pc.indirect_irradiance >= 0.0 ? hfloat(pc.indirect_irradiance)
-                                                    : dot(hvec3(diffuse_light), hvec3(1.0 / 3.0));
-    hfloat average_brightness = dot(hvec3(sh.coeffs[9].rgb), hvec3(1.0 / 3.0));
-    specular *= reflection_mixing_scale(hr, indirect, average_brightness, hfloat(pc.mix_begin_roughness),
-                                        hfloat(pc.mix_end_roughness), hfloat(pc.mix_largest_weight));
-
-    hvec3 diffuse = hfloat(1.0 - metallic) * hvec3(base) * hvec3(diffuse_light);
-    return vec4(vec3(diffuse + specular), 1.0);
+    return vec4(shade_surface(s, n, v, roughness), 1.0);
 }
 
 void main() {

@@ -1,23 +1,13 @@
 #include "context.h"
 
-#include <type_traits>
-
 #include <cstring>
 #include <regex>
 
 #include "harness/common/errors.h"
 #include "spirv_cost.h"
+#include "vk_struct.h"
 
 namespace iblcheck::vk {
-
-// A Vulkan info struct with its sType set and every other member zero (value-initialised, so
-// -Wmissing-field-initializers has nothing to say).
-template <class T> std::remove_cvref_t<T> vk_struct(VkStructureType type) {
-    std::remove_cvref_t<T> t{};
-    t.sType = type;
-    return t;
-}
-
 
 namespace {
 
@@ -209,20 +199,25 @@ Context::Context(const ContextOptions& options) {
         std::string both = info_.driver_info + " " + info_.device_name;
         if (std::regex_search(both, m, llvm_re)) info_.llvm_version = m[1];
 
-        // Queue family with compute.
+        // Queue family with compute, preferably graphics too (shading=fragment draws on it).
         uint32_t nq = 0;
         vkGetPhysicalDeviceQueueFamilyProperties(physical_, &nq, nullptr);
         std::vector<VkQueueFamilyProperties> qf(nq);
         vkGetPhysicalDeviceQueueFamilyProperties(physical_, &nq, qf.data());
         bool found = false;
-        for (uint32_t i = 0; i < nq; ++i)
-            if (qf[i].queueFlags & VK_QUEUE_COMPUTE_BIT) {
-                queue_family_ = i;
-                info_.timestamps = qf[i].timestampValidBits > 0 && chosen->props.limits.timestampComputeAndGraphics;
-                found = true;
-                break;
-            }
+        for (bool need_graphics : {true, false}) {
+            for (uint32_t i = 0; i < nq && !found; ++i)
+                if ((qf[i].queueFlags & VK_QUEUE_COMPUTE_BIT) && (!need_graphics || (qf[i].queueFlags & VK_QUEUE_GRAPHICS_BIT))) {
+                    queue_family_ = i;
+                    info_.timestamps = qf[i].timestampValidBits > 0 && chosen->props.limits.timestampComputeAndGraphics;
+                    info_.graphics = need_graphics;
+                    found = true;
+                }
+        }
         if (!found) throw EnvironmentError(info_.device_name + ": no compute queue");
+        info_.standard_sample_locations = chosen->props.limits.standardSampleLocations;
+        info_.color_sample_counts = chosen->props.limits.framebufferColorSampleCounts;
+        info_.depth_sample_counts = chosen->props.limits.framebufferDepthSampleCounts;
 
         // Features the harness uses: float16 arithmetic (precision=mediump) and 16-bit storage.
         auto f11 = vk_struct<VkPhysicalDeviceVulkan11Features>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_FEATURES);
@@ -234,6 +229,7 @@ Context::Context(const ContextOptions& options) {
         info_.shader_float16 = f12.shaderFloat16;
         info_.storage_16bit = f11.storageBuffer16BitAccess;
         info_.int64_atomics = f2.features.shaderInt64 && f12.shaderBufferInt64Atomics;
+        info_.graphics_stores = f2.features.vertexPipelineStoresAndAtomics && f2.features.fragmentStoresAndAtomics;
 
         auto e11 = vk_struct<VkPhysicalDeviceVulkan11Features>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_FEATURES);
         auto e12 = vk_struct<VkPhysicalDeviceVulkan12Features>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES);
@@ -247,6 +243,8 @@ Context::Context(const ContextOptions& options) {
         e2.features.shaderFloat64 = f2.features.shaderFloat64;
         e2.features.shaderInt64 = f2.features.shaderInt64;                  // instruction counting
         e12.shaderBufferInt64Atomics = f12.shaderBufferInt64Atomics;
+        e2.features.vertexPipelineStoresAndAtomics = f2.features.vertexPipelineStoresAndAtomics; // counting a draw
+        e2.features.fragmentStoresAndAtomics = f2.features.fragmentStoresAndAtomics;
 
         float prio = 1.0f;
         auto qci = vk_struct<VkDeviceQueueCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO);
@@ -610,9 +608,9 @@ ComputePipeline::~ComputePipeline() {
     if (set_layout_) vkDestroyDescriptorSetLayout(dev, set_layout_, nullptr);
 }
 
-void ComputePipeline::dispatch(VkCommandBuffer cmd, const std::vector<Binding>& bindings, const void* push,
-                               uint32_t push_bytes, uint32_t gx, uint32_t gy, uint32_t gz) const {
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);
+void Context::push_descriptors(VkCommandBuffer cmd, VkPipelineBindPoint bind_point, VkPipelineLayout layout,
+                               const std::vector<Binding>& bindings) const {
+    if (bindings.empty()) return;  // zero writes is invalid usage
     std::vector<VkWriteDescriptorSet> writes(bindings.size());
     std::vector<VkDescriptorBufferInfo> bufs(bindings.size());
     std::vector<VkDescriptorImageInfo> imgs(bindings.size());
@@ -631,7 +629,13 @@ void ComputePipeline::dispatch(VkCommandBuffer cmd, const std::vector<Binding>& 
             w.pImageInfo = &imgs[i];
         }
     }
-    ctx_.push_descriptor_fn_(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, uint32_t(writes.size()), writes.data());
+    push_descriptor_fn_(cmd, bind_point, layout, 0, uint32_t(writes.size()), writes.data());
+}
+
+void ComputePipeline::dispatch(VkCommandBuffer cmd, const std::vector<Binding>& bindings, const void* push,
+                               uint32_t push_bytes, uint32_t gx, uint32_t gy, uint32_t gz) const {
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);
+    ctx_.push_descriptors(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, bindings);
     if (push && push_bytes) vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, push_bytes, push);
     vkCmdDispatch(cmd, gx, gy, gz);
 }
@@ -644,10 +648,13 @@ void ComputePipeline::warm_up(VkCommandBuffer cmd, const std::vector<Binding>& b
     Context::barrier(cmd);
 }
 
+// Queries per pass: begin, the marker that resolves it (see context.h), end.
+constexpr uint32_t kQueriesPerPass = 3;
+
 GpuTimer::GpuTimer(Context& ctx, uint32_t max_passes) : ctx_(ctx), max_(max_passes) {
     auto qi = vk_struct<VkQueryPoolCreateInfo>(VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO);
     qi.queryType = VK_QUERY_TYPE_TIMESTAMP;
-    qi.queryCount = 2 * max_passes;
+    qi.queryCount = kQueriesPerPass * max_passes;
     check(vkCreateQueryPool(ctx.device(), &qi, nullptr, &pool_), "vkCreateQueryPool");
 }
 
@@ -656,29 +663,32 @@ GpuTimer::~GpuTimer() {
 }
 
 void GpuTimer::reset(VkCommandBuffer cmd) {
-    vkCmdResetQueryPool(cmd, pool_, 0, 2 * max_);
+    vkCmdResetQueryPool(cmd, pool_, 0, kQueriesPerPass * max_);
     names_.clear();
 }
 
 void GpuTimer::begin(VkCommandBuffer cmd, const std::string& name) {
     if (names_.size() >= max_) throw Error("GpuTimer: more passes than reserved");
-    vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, pool_, uint32_t(2 * names_.size()));
+    const uint32_t q = uint32_t(kQueriesPerPass * names_.size());
+    vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, pool_, q);
+    vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, pool_, q + 1);  // resolves q on lavapipe
     names_.push_back(name);
 }
 
 void GpuTimer::end(VkCommandBuffer cmd) {
-    vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, pool_, uint32_t(2 * names_.size() - 1));
+    vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, pool_, uint32_t(kQueriesPerPass * names_.size() - 1));
 }
 
 std::vector<std::pair<std::string, double>> GpuTimer::results() const {
     std::vector<std::pair<std::string, double>> out;
     if (names_.empty()) return out;
-    std::vector<uint64_t> ts(2 * names_.size());
+    std::vector<uint64_t> ts(kQueriesPerPass * names_.size());
     check(vkGetQueryPoolResults(ctx_.device(), pool_, 0, uint32_t(ts.size()), ts.size() * 8, ts.data(), 8,
                                 VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
           "vkGetQueryPoolResults");
     for (size_t i = 0; i < names_.size(); ++i)
-        out.emplace_back(names_[i], double(ts[2 * i + 1] - ts[2 * i]) * ctx_.info().timestamp_period_ns * 1e-6);
+        out.emplace_back(names_[i], double(ts[kQueriesPerPass * i + 2] - ts[kQueriesPerPass * i]) *
+                                        ctx_.info().timestamp_period_ns * 1e-6);
     return out;
 }
 

@@ -134,6 +134,23 @@ std::string shader_tree_hash() {
     return h.hex();
 }
 
+namespace {
+struct Stage {
+    EShLanguage language;
+    const char* key;  // part of the cache key; "comp" as before graphics stages existed
+};
+Stage stage_of(const fs::path& path) {
+    std::string ext = path.extension().string();
+    if (ext == ".comp") return {EShLangCompute, "comp"};
+    if (ext == ".vert") return {EShLangVertex, "vert"};
+    if (ext == ".frag") return {EShLangFragment, "frag"};
+    throw ShaderCompileError(path.string() + ": unknown shader stage (expected .comp, .vert or .frag)");
+}
+
+CompiledShader compile_stage_file(const fs::path& path_in, Stage stage, const Defines& defines,
+                                  const CompileOptions& options);
+} // namespace
+
 CompiledShader compile_compute_shader(const std::string& name, const Defines& defines, const CompileOptions& options) {
     fs::path p = shader_dir() / name;
     if (!fs::exists(p)) throw ShaderCompileError(p.string() + ": shader source not found");
@@ -142,9 +159,25 @@ CompiledShader compile_compute_shader(const std::string& name, const Defines& de
 
 CompiledShader compile_compute_shader_file(const fs::path& path_in, const Defines& defines,
                                            const CompileOptions& options) {
+    return compile_stage_file(path_in, {EShLangCompute, "comp"}, defines, options);
+}
+
+CompiledShader compile_shader(const std::string& name, const Defines& defines, const CompileOptions& options) {
+    fs::path p = shader_dir() / name;
+    if (!fs::exists(p)) throw ShaderCompileError(p.string() + ": shader source not found");
+    return compile_shader_file(p, defines, options);
+}
+
+CompiledShader compile_shader_file(const fs::path& path, const Defines& defines, const CompileOptions& options) {
+    return compile_stage_file(path, stage_of(path), defines, options);
+}
+
+namespace {
+CompiledShader compile_stage_file(const fs::path& path_in, Stage stage, const Defines& defines,
+                                  const CompileOptions& options) {
     fs::path path = fs::weakly_canonical(path_in);
     Fnv1a64 h;
-    h.update("comp;glslang-vulkan1.2;");
+    h.update(std::string(stage.key) + ";glslang-vulkan1.2;");
     std::set<fs::path> seen;
     hash_sources(path, h, seen);
     std::string preamble = "#extension GL_GOOGLE_include_directive : require\n";
@@ -175,14 +208,14 @@ CompiledShader compile_compute_shader_file(const fs::path& path_in, const Define
     {
         std::lock_guard lock(compile_mutex());
         static GlslangProcess process;
-        glslang::TShader shader(EShLangCompute);
+        glslang::TShader shader(stage.language);
         const char* src = source.c_str();
         std::string name = path.string();
         const char* names = name.c_str();
         shader.setStringsWithLengthsAndNames(&src, nullptr, &names, 1);
         shader.setPreamble(preamble.c_str());
         shader.setEntryPoint("main");
-        shader.setEnvInput(glslang::EShSourceGlsl, EShLangCompute, glslang::EShClientVulkan, 100);
+        shader.setEnvInput(glslang::EShSourceGlsl, stage.language, glslang::EShClientVulkan, 100);
         shader.setEnvClient(glslang::EShClientVulkan, glslang::EShTargetVulkan_1_2);
         shader.setEnvTarget(glslang::EShTargetSpv, glslang::EShTargetSpv_1_5);
         FileIncluder includer;
@@ -194,7 +227,7 @@ CompiledShader compile_compute_shader_file(const fs::path& path_in, const Define
         if (!program.link(msgs)) throw ShaderCompileError(name + ": link: " + format_log(program.getInfoLog()));
         glslang::SpvOptions opt;
         opt.disableOptimizer = true;  // lavapipe's LLVM optimises; keep SPIR-V faithful to the source
-        glslang::GlslangToSpv(*program.getIntermediate(EShLangCompute), out.spirv, &opt);
+        glslang::GlslangToSpv(*program.getIntermediate(stage.language), out.spirv, &opt);
     }
     // The count comes before the fp16 emulation: it measures the shader as written (what a device
     // with native fp16 executes), so the cost a baseline records is the same on every CPU class.
@@ -223,5 +256,7 @@ CompiledShader compile_compute_shader_file(const fs::path& path_in, const Define
     }
     return out;
 }
+
+} // namespace
 
 } // namespace iblcheck::vk

@@ -46,6 +46,12 @@ CompiledShader compile_compute_shader(const std::string& name, const Defines& de
 CompiledShader compile_compute_shader_file(const std::filesystem::path& path, const Defines& defines = {},
                                            const CompileOptions& options = {});
 
+// Any stage, named by the file's extension: .comp, .vert or .frag (graphics_pipeline.h).
+// ShaderCompileError for another extension.
+CompiledShader compile_shader(const std::string& name, const Defines& defines = {}, const CompileOptions& options = {});
+CompiledShader compile_shader_file(const std::filesystem::path& path, const Defines& defines = {},
+                                   const CompileOptions& options = {});
+
 // A hash over every .glsl/.comp file in shader_dir(): the "shader source hash" of provenance.
 std::string shader_tree_hash();
 

@@ -248,7 +248,10 @@ std::vector<uint32_t> instrument_instruction_count(const std::vector<uint32_t>& 
             body.push_back(make(spv::OpIAdd, {u64, sum, loaded, constant(n)}));
             body.push_back(make(spv::OpStore, {counter, sum}));
             size_t terminator = b.end - 1;
-            if (entry && opcode(m.insts[terminator]) == spv::OpReturn) {
+            spv::Op term = opcode(m.insts[terminator]);
+            // An invocation ends at a return of its entry point, or wherever a fragment is
+            // discarded (OpKill, OpTerminateInvocation: in any function).
+            if ((entry && term == spv::OpReturn) || term == spv::OpKill || term == spv::OpTerminateInvocation) {
                 for (; copied < terminator; ++copied) body.push_back(m.insts[copied]);
                 uint32_t total = fresh(), ptr = fresh(), old = fresh();
                 body.push_back(make(spv::OpLoad, {u64, total, counter}));

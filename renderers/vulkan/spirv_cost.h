@@ -4,8 +4,11 @@
 // Wall and timestamp times on a shared CPU vary 2-5x between identical runs, and lavapipe offers no
 // hardware counters, so a cost gate needs a figure that depends on the SPIR-V and the data only.
 // instrument_instruction_count() rewrites a module so that every basic block of every function adds
-// its static instruction count to a per-invocation counter, and every return of an entry point adds
-// that counter to a buffer at (set 0, binding kCostBinding). The count is what the SPIR-V says is
+// its static instruction count to a per-invocation counter, and every return of an entry point (and
+// every fragment discard, OpKill/OpTerminateInvocation) adds that counter to a buffer at (set 0,
+// binding kCostBinding). Any stage: a graphics pipeline binds the buffer to its vertex and fragment
+// stages (graphics_pipeline.h). Helper invocations (the fragment quads' pixels outside the
+// primitive) execute but cannot write memory, so their instructions are not counted. The count is what the SPIR-V says is
 // executed, so it is the same on every CPU class, thread count and driver that takes the same
 // branches; it says nothing about what the driver's compiler makes of it. It counts what ran: on
 // lavapipe an invocation's loops end once it has made 65535 trips in all (gallivm's loop
