@@ -715,7 +715,9 @@ void write_report(const json& results, const fs::path& results_dir, const fs::pa
              speed_chart(gt, "texture_fetches_per_pixel", "fetches-" + id, "Texture fetches per pixel vs error \u00b7 " + g,
                          "texture fetches per pixel", false, go) +
              speed_chart(gt, "precompute_ms", "precompute-" + id, "Precompute time vs error \u00b7 " + g,
-                         "precompute time, ms", true, go);
+                         "precompute time, ms", true, go) +
+             speed_chart(gt, "texture_bytes", "bytes-" + id, "Environment texture bytes vs error \u00b7 " + g,
+                         "prefiltered texture, bytes (storage format, all levels)", true, go);
         o += "</div>\n";
     }
     o += "<details><summary>All tests in one chart</summary><div class=\"charts\">";
@@ -726,7 +728,10 @@ void write_report(const json& results, const fs::path& results_dir, const fs::pa
                                          "Precompute time vs error", "precompute time, ms", true, order) +
                              speed_chart(tests, "texture_fetches_per_pixel", "speed-accuracy-fetches",
                                          "Texture fetches per pixel vs error (driver-independent)",
-                                         "texture fetches per pixel", false, order);
+                                         "texture fetches per pixel", false, order) +
+                             speed_chart(tests, "texture_bytes", "bytes-accuracy",
+                                         "Environment texture bytes vs error (the mobile storage trade-off)",
+                                         "prefiltered texture, bytes (storage format, all levels)", true, order);
         o += charts.empty() ? "<p class=\"meta\">No test has both a cost and an accuracy (FLIP vs a reference golden).</p>"
                             : charts;
     }

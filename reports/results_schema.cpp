@@ -94,7 +94,7 @@ void check_test(const Checker& c, const json& t, size_t i) {
         c.fail(where, fmt::format("verdict '{}' is not one of pass, fail, improved, missing-golden, error", verdict));
     for (const char* k : {"suite", "scene", "method", "env", "variant", "message", "bless_command", "driver_mismatch", "image"})
         c.string_(t, where, k);
-    for (const char* k : {"width", "height", "precompute_ms", "frame_ms", "texture_fetches_per_pixel"})
+    for (const char* k : {"width", "height", "precompute_ms", "frame_ms", "texture_fetches_per_pixel", "texture_bytes", "texel_count"})
         c.number(t, where, k);
     if (const json* o = c.object(t, where, "options"))
         for (auto& [k, v] : o->items())

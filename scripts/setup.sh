@@ -12,6 +12,7 @@ PACKAGES=(
   libopencv-dev libopencv-contrib-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   nlohmann-json3-dev libcli11-dev libfmt-dev
+  libastcenc-dev
   xz-utils
 )
 # Optional: the report's browser test runs where chromium is present; set IBLCHECK_NO_CHROMIUM=1 to skip it.

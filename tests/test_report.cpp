@@ -171,6 +171,8 @@ Fixture& fixture() {
         t2["frame_ms"] = 3.2;
         t2["precompute_ms"] = 40.1;
         t2["texture_fetches_per_pixel"] = 2.5;
+        t2["texture_bytes"] = 1048512;  // the prefiltered chain, RGBA16F
+        t2["texel_count"] = 131064;
         t2["per_sphere"] = per_sphere(1.0);
         t2["stability"] = {{"noise_floor", {{"flip.mean", 0.0004}}}, {"margins", {{"flip.mean", 25.0}}}, {"flaky", false}};
         tests.push_back(t2);
@@ -180,6 +182,7 @@ Fixture& fixture() {
         t3["frame_ms"] = 3.0;
         t3["precompute_ms"] = 38.0;
         t3["texture_fetches_per_pixel"] = 2.0;
+        t3["texture_bytes"] = 62976;  // ASTC 6x6
         tests.push_back(t3);
 
         json t4 = make_test("mobile", "furnace", "constant", "", "missing-golden", "t4");
@@ -372,6 +375,7 @@ TEST(Report, ChartsHaveOnePointPerTest) {
     EXPECT_EQ(declared_points(cs, "speed-accuracy"), 6);
     EXPECT_EQ(declared_points(cs, "speed-accuracy-precompute"), 5);
     EXPECT_EQ(declared_points(cs, "speed-accuracy-fetches"), 5);
+    EXPECT_EQ(declared_points(cs, "bytes-accuracy"), 2);  // t2 and t3 report their texture's bytes
     EXPECT_EQ(declared_points(cs, "error-roughness"), 16);
     EXPECT_EQ(declared_points(cs, "flicker-flip"), 2);
     // Sparklines: 7 runs (6 stored + this one) for each test with that value.
