@@ -312,11 +312,11 @@ TEST(MobileVariants, StorageAndPrecisionChangeTheResultSlightly) {
     cv::Mat ref = render(base).image;
     // Issue 18's storage values and layouts, measured (relative L1 against RGBA32F): astc_hdr
     // 0.0085, astc_ldr_rgbm 0.171 (rgbm8 0.164: most of it is RGBM's range-6 clip of the lights),
-    // octahedral 0.105 (2/3 of the cube's texels), equirect 0.029.
+    // octahedral 0.048 (2/3 of the cube's texels), equirect 0.0225.
     for (auto [k, v, lo, hi] : {std::tuple{"storage", "rgba16f", 1e-6, 0.01}, std::tuple{"storage", "r11g11b10", 1e-5, 0.05},
                                 std::tuple{"storage", "rgbm8", 1e-4, 0.2}, std::tuple{"precision", "mediump", 1e-5, 0.05},
                                 std::tuple{"storage", "astc_hdr", 1e-3, 0.02}, std::tuple{"storage", "astc_ldr_rgbm", 1e-3, 0.25},
-                                std::tuple{"env_layout", "octahedral", 1e-3, 0.16}, std::tuple{"env_layout", "equirect", 1e-3, 0.06}}) {
+                                std::tuple{"env_layout", "octahedral", 1e-3, 0.08}, std::tuple{"env_layout", "equirect", 1e-3, 0.045}}) {
         TestSpec s = base;
         s.options.set(k, v);
         cv::Mat img = render(s).image;

@@ -201,13 +201,12 @@ TEST(StorageLayout, LayoutsMatchTheCubeAndTheirSeamsDoNotShow) {
     // file written here): the 2D layouts against the cube (all RGBA32F). Pixels whose lookup lies
     // within 2 texels (of the level it reads) of a layout's seam — octahedral: the square's edges;
     // lat-long: the u = 0|1 meridian and the poles — must be no worse than the rest, up to 15 %.
-    // Mean relative error, seam / rest pixels, measured:
-    //   with the border:            octahedral r=0.2 0.0063/0.0079, r=0.3 0.0113/0.0117;
-    //                               lat-long   r=0.2 0.0009/0.0027, r=0.3 0.0014/0.0036
-    //   clamp-to-edge (no wrap):    octahedral 0.0102/0.0078, 0.0206/0.0116;
-    //                               lat-long   0.0036/0.0027, 0.0086/0.0036  (fails here)
-    // At r = 0.45 (the 16² level, 14² inside) the octahedral seam pixels are 1.5x the rest even
-    // with the border (bilinear across a fold, where the map's derivative flips; 1.9x clamped).
+    // Mean relative error, seam / rest pixels, measured (r = 0.2, 0.3, 0.45):
+    //   with the border:          octahedral 0.0042/0.0047, 0.0086/0.0082, 0.0171/0.0178
+    //                             lat-long   0.0009/0.0023, 0.0014/0.0031, 0.0035/0.0062
+    //   clamp-to-edge (no wrap):  octahedral 0.0084/0.0047, 0.0185/0.0082  (fails here)
+    //                             lat-long   0.0036/0.0023, 0.0086/0.0031
+    // From r = 0.6 on, the level read is 8x8 (6x6 inside) and the 2-texel band is most of it.
     const std::string env_path = (iblcheck::testutil::temp_dir("layout_seams") / "linear.exr").string();
     {
         cv::Mat eq(256, 512, CV_32FC3);
@@ -219,7 +218,7 @@ TEST(StorageLayout, LayoutsMatchTheCubeAndTheirSeamsDoNotShow) {
             }
         write_exr(env_path, eq);
     }
-    for (const char* rough : {"0.2", "0.3"}) {
+    for (const char* rough : {"0.2", "0.3", "0.45"}) {
         // The level the lookup reads (UE4's mapping, 7 levels of 128: lod = 6 + 1.2·log2 r).
         const double level = std::floor(std::clamp(6.0 + 1.2 * std::log2(std::atof(rough)), 0.0, 6.0));
         Opts base = {{"metallic", "1"}, {"roughness", rough}, {"storage", "rgba32f"}, {"ssaa", "1"}};
@@ -254,7 +253,7 @@ TEST(StorageLayout, LayoutsMatchTheCubeAndTheirSeamsDoNotShow) {
             rest_err /= rest_n;
             std::printf("[ seam ] %s r=%s: seam pixels %.3g (n=%g) rest %.3g (n=%g)\n", layout, rough, seam_err, seam_n, rest_err, rest_n);
             EXPECT_LT(seam_err, 1.15 * rest_err + 2e-4) << layout << " r=" << rough;
-            EXPECT_LT(rest_err, 0.02) << layout << " r=" << rough;
+            EXPECT_LT(rest_err, 0.03) << layout << " r=" << rough;  // measured at most 0.018
         }
     }
     expect_no_validation_errors();

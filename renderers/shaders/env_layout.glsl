@@ -99,7 +99,10 @@ vec4 sample_env_2d(sampler2D s, vec3 d, float lod) {
     vec2 p = layout_inner_uv(d);
     float l0 = floor(lod);
     float l1 = min(l0 + 1.0, float(textureQueryLevels(s) - 1));
-    vec2 s0 = vec2(textureSize(s, int(l0))), s1 = vec2(textureSize(s, int(l1)));
+    // Level sizes from the base size: textureSize(s, lod) with a lod that differs between
+    // invocations gives llvmpipe-version- and CPU-class-dependent answers.
+    ivec2 base = textureSize(s, 0);
+    vec2 s0 = vec2(max(base >> int(l0), ivec2(1))), s1 = vec2(max(base >> int(l1), ivec2(1)));
     vec4 a = textureLod(s, (1.0 + p * (s0 - 2.0)) / s0, l0);
     vec4 b = textureLod(s, (1.0 + p * (s1 - 2.0)) / s1, l1);
     return mix(a, b, lod - l0);
