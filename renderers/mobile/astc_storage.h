@@ -8,7 +8,8 @@
 // fp16) and HDR (the block's fp16 values) alike.
 //
 // Determinism (goldens must be portable): one encoder thread, a fixed quality preset
-// (kAstcQuality), and astcenc's own invariance (its builds give the same blocks on every SIMD ISA).
+// (kAstcQuality), astcenc's own invariance (its builds give the same blocks on every SIMD ISA),
+// and the same first compression in every process (astc_storage.cpp: astcenc 4.2 remembers it).
 #pragma once
 #include <cstdint>
 #include <string>
