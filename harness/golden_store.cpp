@@ -62,7 +62,7 @@ std::string safe_file_name(const std::string& name) {
 
 std::string reference_key(const TestSpec& spec) {
     std::string key = spec.scene + "__" + safe_file_name(spec.env);
-    static const std::set<std::string> material = {"roughness", "metallic", "base_color", "env_rotation"};
+    static const std::set<std::string> material = {"roughness", "metallic", "base_color", "env_rotation", "ao"};
     std::string extra;
     for (auto& [k, v] : spec.options.values())
         if (material.count(k)) extra += (extra.empty() ? "" : ",") + k + "=" + v;

@@ -108,6 +108,10 @@ void record_render(json& r, const RenderResult& rr) {
     r["precompute_ms"] = pre;
     r["frame_ms"] = frame;
     r["texture_fetches_per_pixel"] = rr.texture_fetches_per_pixel;
+    if (rr.texture_bytes > 0) {  // the bytes/accuracy chart's x (mobile: the prefiltered chain)
+        r["texture_bytes"] = rr.texture_bytes;
+        r["texel_count"] = rr.texel_count;
+    }
     r["cost"] = render_cost(rr);
     r["provenance"] = rr.provenance;
 }

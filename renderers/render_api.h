@@ -35,6 +35,10 @@ struct RenderResult {
     // ray included (renderers/vulkan/spirv_cost.h): deterministic, unlike the timings. 0 for the
     // CPU reference and on a device that cannot count.
     double shader_instructions_per_pixel = 0;
+    // The environment texture the shading pass samples (mobile: the prefiltered chain) as a device
+    // would store it: texels and bytes in its storage format. 0 where a method has none.
+    uint64_t texel_count = 0;
+    uint64_t texture_bytes = 0;
 };
 
 } // namespace iblcheck

@@ -110,6 +110,50 @@ std::string cost_panel(const std::string& id, const std::string& title, const st
     return render_chart(c);
 }
 
+// Texture memory (x: the environment texture's bytes in its storage format, every level) against
+// accuracy (y) for one scene and environment: the mobile storage trade-off (ASTC blocks, RGBM,
+// layouts). Bytes are deterministic, so the front is drawn.
+std::string bytes_panel(const std::string& id, const std::string& title, const std::vector<const json*>& tests,
+                        const std::vector<size_t>& page, Markers& markers) {
+    Chart c;
+    c.id = id;
+    c.title = title;
+    c.width = 440;
+    c.plot_height = 230;
+    c.legend = false;
+    c.pareto = true;
+    c.x = {"environment texture, bytes (storage format, all levels)", true, {}, {}};
+    c.y = {"mean FLIP vs the truth", false, {}, {}};
+    std::map<std::pair<std::string, std::string>, size_t> series;
+    size_t n = 0;
+    for (size_t k = 0; k < tests.size(); ++k) {
+        const json& t = *tests[k];
+        auto f = num(sub(t, "accuracy"), "flip_mean");
+        auto x = num(t, "texture_bytes");
+        if (!f || !x || *x <= 0) continue;
+        const std::string m = str(t, "method"), fam = variant_family(t);
+        auto key = std::pair{m, fam};
+        if (!series.count(key)) {
+            series[key] = c.series.size();
+            ChartSeries s = make_series(m + " \u00b7 " + fam, method_color(m));
+            s.marker = markers.of(fam).shape;
+            s.hollow = markers.of(fam).hollow;
+            c.series.push_back(std::move(s));
+        }
+        ChartPoint p;
+        p.x = *x;
+        p.y = *f;
+        p.label = point_label(t);
+        const auto texels = num(t, "texel_count");
+        p.tooltip = fmt::format("{}\n{} bytes{}, mean FLIP vs the truth {}", str(t, "name"), fmt_num(*x),
+                                texels ? fmt::format(" ({} texels)", fmt_num(*texels)) : std::string(), fmt_num(*f));
+        p.href = "#" + test_id(page[k]);
+        c.series[series[key]].points.push_back(std::move(p));
+        ++n;
+    }
+    return n < 2 ? "" : render_chart(c);
+}
+
 // Wall time: median with the range of the repeated timings (x), accuracy (y); no front.
 std::string wall_panel(const std::string& id, const std::string& title, const std::vector<const json*>& tests,
                        const std::vector<size_t>& page, Markers& markers) {
@@ -224,7 +268,7 @@ std::string charts_html(const std::vector<const json*>& tests, const std::vector
     Markers markers;
     markers.of("default");
     std::set<std::string> methods;
-    std::string cost, wall;
+    std::string cost, wall, bytes;
     for (auto& [g, idx] : ordered) {
         std::vector<const json*> gt;
         std::vector<size_t> page;
@@ -240,6 +284,7 @@ std::string charts_html(const std::vector<const json*>& tests, const std::vector
         if (mobile >= 3 && others > 0)
             cost += cost_panel("cost-accuracy-mobile-" + slug(g), g + " \u00b7 mobile variants", gt, page, markers, "mobile");
         wall += wall_panel("wall-accuracy-" + slug(g), g, gt, page, markers);
+        bytes += bytes_panel("bytes-accuracy-" + slug(g), g, gt, page, markers);
     }
     o += "<h2 id=\"cost-accuracy\">Cost against accuracy</h2>\n<p class=\"meta\">One panel per scene and environment. "
          "x: SPIR-V instructions the shading dispatch executed per pixel (counted by an instrumented twin of the "
@@ -255,6 +300,13 @@ std::string charts_html(const std::vector<const json*>& tests, const std::vector
          "is drawn on it.</p>\n";
     o += wall.empty() ? "<p class=\"meta\">No test has both a frame time and an accuracy against the truth.</p>"
                       : "<div class=\"charts\">" + wall + "</div>\n";
+    o += "<h2 id=\"bytes-accuracy\">Texture memory against accuracy</h2>\n<p class=\"meta\">x: the environment "
+         "texture the shading samples (mobile: the prefiltered chain, every level, the borders of 2D layouts included) "
+         "in bytes as a device stores it (ASTC: 16 bytes a block); y: mean FLIP against the truth. The storage "
+         "trade-off: lower-left is better.</p>\n";
+    o += bytes.empty() ? "<p class=\"meta\">No scene and environment has two tests with a texture size and an accuracy "
+                         "against the truth.</p>"
+                       : "<div class=\"charts\">" + bytes + "</div>\n";
 
     // Error against roughness: per environment, one panel per variant family against the default.
     o += "<h2 id=\"roughness\">Error against roughness</h2>\n<p class=\"meta\">Per sphere, one row per scene and "

@@ -95,7 +95,7 @@ void check_test(const Checker& c, const json& t, size_t i) {
     for (const char* k : {"suite", "scene", "method", "env", "variant", "message", "bless_command", "driver_mismatch", "image",
                           "image_exr"})
         c.string_(t, where, k);
-    for (const char* k : {"width", "height", "precompute_ms", "frame_ms", "texture_fetches_per_pixel"})
+    for (const char* k : {"width", "height", "precompute_ms", "frame_ms", "texture_fetches_per_pixel", "texture_bytes", "texel_count"})
         c.number(t, where, k);
     c.number_map(t, where, "cost");
     if (const json* smp = c.array(t, where, "frame_ms_samples"))

@@ -14,6 +14,7 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   nlohmann-json3-dev libcli11-dev libfmt-dev
   clang-format clang-tidy
+  libastcenc-dev
   xz-utils zlib1g-dev
 )
 # Optional: the report's browser test runs where chromium is present; set IBLCHECK_NO_CHROMIUM=1 to skip it.

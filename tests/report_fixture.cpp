@@ -199,6 +199,8 @@ SmallRun& small_run() {
         t2["precompute_ms"] = 40.1;
         t2["texture_fetches_per_pixel"] = 2.5;
         t2["cost"] = {{"spirv_instructions_per_pixel", 6300.0}, {"texture_fetches_per_pixel", 2.5}};
+        t2["texture_bytes"] = 1048512;  // the prefiltered chain, RGBA16F
+        t2["texel_count"] = 131064;
         t2["per_sphere"] = per_sphere(1.0);
         t2["stability"] = {{"noise_floor", {{"flip.mean", 0.0004}}}, {"margins", {{"flip.mean", 25.0}}}, {"flaky", false}};
         t2["comparisons"][0]["approved"] = {{"commit", "c3"}, {"date", "2026-11-13T03:00:00Z"},
@@ -217,6 +219,7 @@ SmallRun& small_run() {
         t3["precompute_ms"] = 38.0;
         t3["texture_fetches_per_pixel"] = 2.0;
         t3["cost"] = {{"spirv_instructions_per_pixel", 6200.0}};
+        t3["texture_bytes"] = 62976;  // ASTC 6x6
         tests.push_back(t3);
 
         json t4 = make_test("mobile", "furnace", "constant", "", "missing-golden", "t4");

@@ -126,7 +126,9 @@ TEST(Suite, ShardsPartitionTheSuite) {
         for (auto& t : select_tests(ci, "", i, 3)) seen.insert(t.name);
     EXPECT_EQ(seen.size(), ci.tests.size());
     for (auto& t : ci.tests) EXPECT_EQ(seen.count(t.name), 1u) << t.name;
-    EXPECT_EQ(select_tests(ci, "mobile.furnace.*", 0, 1).size(), 4u);  // default and env_brdf=lut, in both shading paths
+    // The furnace: default and env_brdf=lut in both shading paths, and issue 18's astc_hdr 6x6,
+    // astc_ldr_rgbm, octahedral, equirect and directional.
+    EXPECT_EQ(select_tests(ci, "mobile.furnace.*", 0, 1).size(), 9u);
     EXPECT_THROW(select_tests(ci, "", 3, 3), UsageError);
 }
 
@@ -332,6 +334,27 @@ TEST(Cli, BadInputExitsTwo) {
     EXPECT_EQ(run_command(iblcheck_bin() + " render --scene sphere --env /nonexistent.exr", out), 2);
     EXPECT_NE(out.find("/nonexistent.exr"), std::string::npos) << out;
     EXPECT_EQ(run_command(iblcheck_bin() + " run --suite ci --filter 'nothing*'", out), 2);
+    // Issue 18's options: unknown values, a chain too short for a 2D layout's border, AO out of range.
+    EXPECT_EQ(run_command(iblcheck_bin() + " render --scene sphere --set env_layout=sphere", out), 2);
+    EXPECT_NE(out.find("env_layout"), std::string::npos) << out;
+    EXPECT_EQ(run_command(iblcheck_bin() + " render --scene sphere --set storage=astc_hdr --set astc_block=5x5", out), 2);
+    EXPECT_NE(out.find("astc_block"), std::string::npos) << out;
+    EXPECT_EQ(run_command(iblcheck_bin() + " render --scene sphere --set env_layout=octahedral --set mips=8", out), 2);
+    EXPECT_NE(out.find("mips <= 7"), std::string::npos) << out;
+    EXPECT_EQ(run_command(iblcheck_bin() + " render --scene sphere --set ao=2", out), 2);
+    EXPECT_NE(out.find("'ao'"), std::string::npos) << out;
+}
+
+TEST(Cli, RenderReportsTheEnvironmentTexture) {
+    // The prefiltered chain's texels and bytes (7 levels of a 128 cube; ASTC 4x4: 16 bytes a block).
+    std::string out;
+    ASSERT_EQ(run_command(iblcheck_bin() + " render --scene sphere --env constant:1 --set storage=astc_hdr --json - 2>/dev/null", out), 0) << out;
+    auto j = nlohmann::json::parse(out.substr(out.find('{')));
+    EXPECT_EQ(j["texture_bytes"].get<uint64_t>(), 6u * 16 * (1024 + 256 + 64 + 16 + 4 + 1 + 1));
+    EXPECT_EQ(j["texel_count"].get<uint64_t>(), 6u * 21844);
+    bool encoded = false;
+    for (auto& t : j["timings"]) encoded |= t["pass"] == "astc_encode" && t["precompute"] == true;
+    EXPECT_TRUE(encoded) << out;
 }
 
 TEST(Suites, TemporalAndStabilitySuitesPass) {

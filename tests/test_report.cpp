@@ -178,6 +178,16 @@ TEST(Report, ChartsAreSmallMultiplesOnTheStableCost) {
     // Flicker against FLIP: one panel per environment; labels say what differs, the env included.
     EXPECT_EQ(declared_points(cs, "flicker-flip-rotation-sky-sun"), 2);
     EXPECT_NE(html.find("data-label=\"mobile temporal \u00b7 sky_sun\""), std::string::npos);
+    // Texture memory against accuracy (issue 18's storage trade-off): t2 and t3 report their bytes;
+    // bytes are deterministic, so the front is drawn (t3 is smaller, t2 more accurate: both on it).
+    EXPECT_EQ(declared_points(cs, "bytes-accuracy-roughness-sweep-studio"), 2);
+    {
+        const size_t b = html.find("data-chart=\"bytes-accuracy-roughness-sweep-studio\"");
+        ASSERT_NE(b, std::string::npos);
+        const std::string chart = html.substr(b, html.find("</svg>", b) - b);
+        EXPECT_NE(chart.find("class=\"pareto-front\" data-front=\"2\""), std::string::npos);
+        EXPECT_NE(chart.find("131064 texels"), std::string::npos);
+    }
     // Sparklines: 7 runs (6 stored + this one) for each test with that value.
     int spark = 0;
     for (auto& c : cs)

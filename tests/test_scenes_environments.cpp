@@ -277,7 +277,14 @@ TEST(Scene, MaterialOptions) {
     EXPECT_THROW(build_scene("sphere", bad), UsageError);
     EXPECT_EQ(scene_option_keys(), (std::vector<std::string>{"roughness", "metallic", "base_color", "frame",
                                                               "bump_amplitude", "bump_frequency", "roughness_bias",
-                                                              "camera_shift"}));
+                                                              "camera_shift", "ao"}));
+    // ao reaches every sphere of any scene, and is checked like the other material options.
+    OptionMap occluded;
+    occluded.set("ao", "0.25");
+    for (const Sphere& sp : build_scene("roughness_sweep", occluded).spheres) EXPECT_FLOAT_EQ(sp.material.ao, 0.25f);
+    EXPECT_FLOAT_EQ(build_scene("sphere", {}).spheres[0].material.ao, 1.0f);
+    occluded.set("ao", "1.5");
+    EXPECT_THROW(build_scene("sphere", occluded), UsageError);
 }
 
 TEST(Scene, BumpySphereMovesItsDetailEachFrame) {

@@ -81,6 +81,8 @@ void register_render_command(CLI::App& app, int& exit_code) {
         // The deterministic cost (issue 14): the same on every run, where the times above are not.
         if (r.shader_instructions_per_pixel > 0)
             fmt::print(human, "spirv instr/px      {:.2f}\n", r.shader_instructions_per_pixel);
+        if (r.texture_bytes > 0)
+            fmt::print(human, "env texture         {} texels, {} bytes\n", r.texel_count, r.texture_bytes);
         if (!out.empty()) {
             write_exr(out, r.image);
             write_png(png.string(), display_transform(r.image));
@@ -91,6 +93,10 @@ void register_render_command(CLI::App& app, int& exit_code) {
             j["provenance"] = r.provenance;
             j["texture_fetches_per_pixel"] = r.texture_fetches_per_pixel;
             j["shader_instructions_per_pixel"] = r.shader_instructions_per_pixel;
+            if (r.texture_bytes > 0) {
+                j["texture_bytes"] = r.texture_bytes;
+                j["texel_count"] = r.texel_count;
+            }
             for (auto& t : r.timings)
                 j["timings"].push_back({{"pass", t.name}, {"ms", t.ms}, {"gpu", t.gpu}, {"precompute", t.precompute}});
             if (json_out == "-") {

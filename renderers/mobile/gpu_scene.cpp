@@ -27,8 +27,17 @@ Scene scene_for(const TestSpec& spec, int& width, int& height) {
     return scene;
 }
 
+bool scene_uses_ao(const Scene& scene) {
+    for (const Sphere& sp : scene.spheres)
+        if (sp.material.ao != 1.0f) return true;
+    return false;
+}
+
 vk::Buffer upload_scene(vk::Context& ctx, const Scene& scene) {
-    const size_t header = 5 * 16, per_sphere = 3 * 16;
+    // A fourth vec4 per sphere (ao_pad) only when a sphere is occluded: scene.glsl declares it under
+    // MATERIAL_AO, so scenes without AO keep the layout (and the shaders' code) they had.
+    const bool ao = scene_uses_ao(scene);
+    const size_t header = 5 * 16, per_sphere = (ao ? 4 : 3) * 16;
     vk::Buffer buf = ctx.create_buffer(header + per_sphere * std::max<size_t>(1, scene.spheres.size()));
     auto* f = buf.as<float>();
     const Camera& c = scene.camera;
@@ -51,6 +60,10 @@ vk::Buffer upload_scene(vk::Context& ctx, const Scene& scene) {
         s[10] = sp.bump_frequency;
         s[11] = sp.bump_phase;
         s += 12;
+        if (ao) {
+            put(s, {sp.material.ao, 0, 0}, 0);
+            s += 4;
+        }
     }
     return buf;
 }

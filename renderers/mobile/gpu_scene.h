@@ -8,6 +8,9 @@
 
 namespace iblcheck {
 vk::Buffer upload_scene(vk::Context& ctx, const Scene& scene);
+// Whether a sphere has material AO (ao < 1): then each sphere carries a fourth vec4 and the
+// shaders that read the scene are compiled with MATERIAL_AO (scene.glsl).
+bool scene_uses_ao(const Scene& scene);
 // The spec's scene and image size (0 in the spec: the scene's default size).
 Scene scene_for(const TestSpec& spec, int& width, int& height);
 // Reads back a vec4 image (rgb + coverage) into CV_32FC3 and returns the mean coverage.

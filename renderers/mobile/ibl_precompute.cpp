@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstring>
 
+#include "astc_storage.h"
+#include "env_layout.h"
 #include "harness/common/errors.h"
 #include "renderers/option_table.h"
 
@@ -17,19 +19,69 @@ constexpr VkDescriptorType kStorageBuffer = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
 
 uint32_t groups(uint32_t n, uint32_t local = 8) { return (n + local - 1) / local; }
 
+bool is_astc(const std::string& storage) { return storage == "astc_hdr" || storage == "astc_ldr_rgbm"; }
+
 VkFormat storage_format(const std::string& storage, bool native_r11g11b10) {
     if (storage == "rgba32f") return VK_FORMAT_R32G32B32A32_SFLOAT;
     if (storage == "rgba16f") return VK_FORMAT_R16G16B16A16_SFLOAT;
     if (storage == "rgbm8") return VK_FORMAT_R8G8B8A8_UNORM;
     if (storage == "r11g11b10") return native_r11g11b10 ? VK_FORMAT_B10G11R11_UFLOAT_PACK32 : VK_FORMAT_R16G16B16A16_SFLOAT;
-    throw UsageError("option 'storage': unknown value '" + storage + "'; valid: rgba16f, rgba32f, rgbm8, r11g11b10");
+    // ASTC: the prefilter pass writes full precision for the host's encoder (astc_storage.h).
+    if (is_astc(storage)) return VK_FORMAT_R32G32B32A32_SFLOAT;
+    throw UsageError("option 'storage': unknown value '" + storage + "'; valid: rgba16f, rgba32f, rgbm8, r11g11b10, astc_hdr, astc_ldr_rgbm");
+}
+
+// Every level of every layer of `encoded` (RGBA32F, as the prefilter pass wrote it) through the
+// ASTC codec; returns the decoded texels in an RGBA16F image of the same shape, which the shading
+// pass samples. The encode and decode times are precompute passes (on the CPU).
+vk::Image astc_round_trip(vk::Context& ctx, const vk::Image& encoded, const PrecomputeSettings& s,
+                          std::vector<PassTiming>& timings) {
+    AstcFormat format;
+    format.profile = s.storage == "astc_hdr" ? AstcProfile::hdr : AstcProfile::ldr_rgbm;
+    format.block = astc_block_from_option(s.astc_block);
+    format.rgbm_range = s.rgbm_range;
+    AstcCodec codec(format);
+    vk::Image decoded = ctx.create_image(VK_FORMAT_R16G16B16A16_SFLOAT, encoded.width, encoded.height, encoded.mips, encoded.cube);
+    std::vector<vk::Buffer> staging;
+    double encode_ms = 0, decode_ms = 0;
+    for (uint32_t m = 0; m < encoded.mips; ++m) {
+        const uint32_t w = std::max(1u, encoded.width >> m), h = std::max(1u, encoded.height >> m);
+        const size_t layer_texels = size_t(w) * h;
+        std::vector<float> texels = ctx.download(encoded, m);
+        staging.push_back(ctx.create_buffer(layer_texels * encoded.layers * 8, VK_BUFFER_USAGE_TRANSFER_SRC_BIT));
+        auto* dst = staging.back().as<uint16_t>();
+        for (uint32_t layer = 0; layer < encoded.layers; ++layer) {
+            AstcRoundTrip rt = codec.round_trip(texels.data() + layer * layer_texels * 4, w, h);
+            std::memcpy(dst + layer * layer_texels * 4, rt.decoded_half.data(), layer_texels * 8);
+            encode_ms += rt.encode_ms;
+            decode_ms += rt.decode_ms;
+        }
+    }
+    ctx.submit([&](VkCommandBuffer cmd) {
+        ctx.transition(cmd, decoded, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
+        for (uint32_t m = 0; m < encoded.mips; ++m) ctx.copy_buffer_to_image(cmd, staging[m], decoded, m);
+        ctx.transition(cmd, decoded, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL);
+    });
+    timings.push_back({"astc_encode", encode_ms, false, true});
+    timings.push_back({"astc_decode", decode_ms, false, true});
+    return decoded;
 }
 
 } // namespace
 
+uint64_t storage_level_bytes(const std::string& storage, const std::string& astc_block, uint32_t width,
+                             uint32_t height, uint32_t layers) {
+    if (is_astc(storage)) return astc_image_bytes(width, height, astc_block_from_option(astc_block)) * layers;
+    uint64_t texels = uint64_t(width) * height * layers;
+    if (storage == "rgba32f") return texels * 16;
+    if (storage == "rgba16f") return texels * 8;
+    if (storage == "rgbm8" || storage == "r11g11b10") return texels * 4;
+    throw UsageError("option 'storage': unknown value '" + storage + "'");
+}
+
 vk::Defines storage_defines(const PrecomputeSettings& s, bool native_r11g11b10) {
-    vk::Defines d = glsl_defines({{"storage", s.storage}, {"mip_mapping", s.mip_mapping}});
-    if (s.storage == "rgbm8") d["RGBM_RANGE"] = std::to_string(s.rgbm_range);
+    vk::Defines d = glsl_defines({{"storage", s.storage}, {"mip_mapping", s.mip_mapping}, {"env_layout", s.env_layout}});
+    if (s.storage == "rgbm8" || s.storage == "astc_ldr_rgbm") d["RGBM_RANGE"] = std::to_string(s.rgbm_range);
     if (s.storage == "r11g11b10" && native_r11g11b10) d["STORAGE_NATIVE_R11G11B10"] = "1";
     return d;
 }
@@ -43,6 +95,10 @@ IblResources run_precompute(GpuSession& gpu, const Environment& env, const Preco
     r.full_mips = uint32_t(std::log2(double(s.cube_size))) + 1;
     uint32_t mips = std::min(s.mips, r.full_mips);
     if (mips < 1) throw UsageError("option 'mips' must be at least 1");
+    const EnvLayout layout = env_layout_from_option(s.env_layout);
+    const LayoutExtent extent = layout_extent(layout, s.cube_size);
+    if (s.prefiltered) check_layout_mips(layout, s.cube_size, mips);
+    if (is_astc(s.storage)) astc_block_from_option(s.astc_block);  // a bad block is a usage error before any work
 
     // Upload the equirect (RGB float → RGBA32F).
     const cv::Mat& eq = env.equirect;
@@ -66,8 +122,14 @@ IblResources run_precompute(GpuSession& gpu, const Environment& env, const Preco
     if (!ctx.format_supports(pf, VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT | VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT))
         throw EnvironmentError(ctx.info().device_name + ": storage=" + s.storage +
                                " needs a format usable as a filtered storage image");
-    r.prefiltered = s.prefiltered ? ctx.create_image(pf, s.cube_size, s.cube_size, mips, true)
+    r.prefiltered = s.prefiltered ? ctx.create_image(pf, extent.width, extent.height, mips, layout == EnvLayout::cube)
                                   : ctx.create_image(VK_FORMAT_R16G16B16A16_SFLOAT, 1, 1, 1, true);
+    if (s.prefiltered) {
+        r.texel_count = layout_texel_count(layout, s.cube_size, mips);
+        for (uint32_t m = 0; m < mips; ++m)
+            r.texture_bytes += storage_level_bytes(s.storage, s.astc_block, std::max(1u, extent.width >> m),
+                                                   std::max(1u, extent.height >> m), extent.layers);
+    }
     r.sh = ctx.create_buffer(10 * 16);
     r.lut = s.lut ? ctx.create_image(VK_FORMAT_R16G16_SFLOAT, s.lut_size, s.lut_size, 1, false)
                   : ctx.create_image(VK_FORMAT_R16G16_SFLOAT, 1, 1, 1, false);
@@ -125,12 +187,14 @@ IblResources run_precompute(GpuSession& gpu, const Environment& env, const Preco
                                         vk::Binding::storage_image(1, r.prefiltered.storage_views[0])}, &pw, sizeof pw);
                     timer.begin(cmd, "prefilter_ggx");
                 }
+                // dst_size: the cube's face size, or a 2D layout level's width (its height follows).
+                const uint32_t w = std::max(1u, extent.width >> m), h = std::max(1u, extent.height >> m);
                 struct { uint32_t mip, dst_size, src_size, samples; float full_mips, max_lod, src_max_lod; } pp{
-                    m, std::max(1u, s.cube_size >> m), s.cube_size, s.prefilter_samples, float(r.full_mips),
+                    m, w, s.cube_size, s.prefilter_samples, float(r.full_mips),
                     float(mips - 1), float(r.full_mips - 1)};
                 p_pre.dispatch(cmd, {vk::Binding::sampled_image(0, r.source_cube.sampled_view, ctx.linear_sampler()),
                                      vk::Binding::storage_image(1, r.prefiltered.storage_views[m])},
-                               &pp, sizeof pp, groups(pp.dst_size), groups(pp.dst_size), 6);
+                               &pp, sizeof pp, groups(w), groups(h), extent.layers);
             }
             timer.end(cmd);
             ctx.barrier(cmd);
@@ -169,6 +233,7 @@ IblResources run_precompute(GpuSession& gpu, const Environment& env, const Preco
         ctx.barrier(cmd);
     });
     for (auto& [name, ms] : timer.results()) timings.push_back({name, ms, true, true});
+    if (s.prefiltered && is_astc(s.storage)) r.prefiltered = astc_round_trip(ctx, r.prefiltered, s, timings);
     return r;
 }
 
@@ -176,7 +241,7 @@ std::shared_ptr<IblResources> precompute_cached(GpuSession& gpu, const Environme
                                                 std::vector<PassTiming>& timings, bool& cached) {
     std::string key = "ibl;" + env.content_hash + ";" + std::to_string(s.cube_size) + ";" + std::to_string(s.mips) + ";" +
                       std::to_string(s.prefilter_samples) + ";" + s.mip_mapping + ";" + s.storage + ";" +
-                      std::to_string(s.rgbm_range) + ";" + std::to_string(s.prefiltered) + ";" + std::to_string(s.lut) +
+                      std::to_string(s.rgbm_range) + ";" + s.astc_block + ";" + s.env_layout + ";" + std::to_string(s.prefiltered) + ";" + std::to_string(s.lut) +
                       ";" + std::to_string(s.lut_size) + ";" + std::to_string(s.lut_samples) + ";" +
                       std::to_string(s.irradiance_cube) + ";" + std::to_string(s.irradiance_size) + ";" +
                       std::to_string(s.env_rotation_deg);

@@ -16,8 +16,10 @@ struct PrecomputeSettings {
     uint32_t mips = 7;               // levels of the prefiltered chain (the first seed's 7)
     uint32_t prefilter_samples = 64;
     std::string mip_mapping = "ue4"; // ue4 | filament | origin
-    std::string storage = "rgba16f"; // rgba16f | rgba32f | rgbm8 | r11g11b10
+    std::string storage = "rgba16f"; // rgba16f | rgba32f | rgbm8 | r11g11b10 | astc_hdr | astc_ldr_rgbm
+    std::string astc_block = "4x4";  // storage=astc_*: 4x4 | 6x6
     float rgbm_range = 6.0f;
+    std::string env_layout = "cube"; // cube | octahedral | equirect (env_layout.h)
     bool prefiltered = true;         // build the GGX chain (the sampled method does not need it)
     bool lut = false;                // env_brdf=lut
     uint32_t lut_size = 64;
@@ -29,13 +31,22 @@ struct PrecomputeSettings {
 
 struct IblResources {
     vk::Image source_cube;   // rgba32f, full box pyramid
-    vk::Image prefiltered;   // storage format, `mips` levels
+    vk::Image prefiltered;   // storage format (ASTC: its decoded texels, RGBA16F), `mips` levels, env_layout
     vk::Buffer sh;           // 10 × vec4: SH9 of E/π, then the mean radiance
     vk::Image lut;           // rg16f (1×1 placeholder when unused)
     vk::Image irradiance;    // rgba32f cube (1×1 placeholder when unused)
     uint32_t full_mips = 0;  // log2(cube_size) + 1
     bool native_r11g11b10 = false;
+    // The prefiltered chain as a device would store it: texels (borders of 2D layouts included)
+    // and bytes in the storage format (ASTC: its blocks; r11g11b10: 4 bytes a texel even where
+    // lavapipe holds it in RGBA16F).
+    uint64_t texel_count = 0;
+    uint64_t texture_bytes = 0;
 };
+
+// Bytes of one w×h level of `layers` layers in the storage format.
+uint64_t storage_level_bytes(const std::string& storage, const std::string& astc_block, uint32_t width,
+                             uint32_t height, uint32_t layers);
 
 // Records and runs the precompute passes; appends their GPU timings (precompute = true).
 IblResources run_precompute(GpuSession& gpu, const Environment& env, const PrecomputeSettings& s,
@@ -48,8 +59,8 @@ std::shared_ptr<IblResources> precompute_cached(GpuSession& gpu, const Environme
                                                 std::vector<PassTiming>& timings, bool& cached);
 
 // The defines of the passes that read or write the prefiltered chain: the option table's for
-// storage and mip_mapping (storage.glsl, mip_mapping.glsl), plus the RGBM range and whether
-// R11G11B10 is stored natively.
+// storage, mip_mapping and env_layout (storage.glsl, mip_mapping.glsl, env_layout.glsl), plus the
+// RGBM range and whether R11G11B10 is stored natively.
 vk::Defines storage_defines(const PrecomputeSettings& s, bool native_r11g11b10);
 
 } // namespace iblcheck

@@ -32,6 +32,8 @@ RenderResult render_mobile(GpuSession& gpu, const Environment& env, const TestSp
     const std::map<std::string, std::string> variant = shader_selections(o, "mobile");
     ps.mip_mapping = variant.at("mip_mapping");
     ps.storage = variant.at("storage");
+    ps.astc_block = option_choice(o, "astc_block");
+    ps.env_layout = variant.at("env_layout");
     ps.rgbm_range = float(o.get_double("rgbm_range", 6.0));
     ps.lut = variant.at("env_brdf") == "lut";
     ps.lut_size = uint32_t(o.get_int("lut_size", 64));
@@ -56,6 +58,7 @@ RenderResult render_mobile(GpuSession& gpu, const Environment& env, const TestSp
     vk::Defines defs = storage_defines(ps, ibl.native_r11g11b10);
     defs.merge(glsl_defines(variant));  // keeps storage_defines' entries; adds the other selections
     const bool fragment = variant.at("shading") == "fragment";
+    if (scene_uses_ao(scene)) defs["MATERIAL_AO"] = "1";  // scene.glsl: each sphere carries its AO
 
     vk::Context& ctx = gpu.ctx();
     vk::Buffer scene_buf = upload_scene(ctx, scene);
@@ -82,9 +85,11 @@ RenderResult render_mobile(GpuSession& gpu, const Environment& env, const TestSp
                                   vk::Binding::storage_buffer(2, ibl.sh),
                                   vk::Binding::sampled_image(3, ibl.lut.sampled_view, ctx.linear_sampler()),
                                   vk::Binding::sampled_image(4, ibl.irradiance.sampled_view, ctx.linear_sampler())};
-    // Texture samples per shading: one prefiltered-cube read, plus the LUT and the irradiance
-    // cube when used (SH9 is arithmetic).
-    double per_hit = 1.0 + (ps.lut ? 1.0 : 0.0) + (ps.irradiance_cube ? 1.0 : 0.0);
+    // Texture samples per shading: one prefiltered-cube read (two for a 2D layout, one per level:
+    // env_layout.glsl; a second read at n for normalization=directional), plus the LUT and the
+    // irradiance cube when used (SH9 is arithmetic).
+    const double env_reads = (variant.at("normalization") == "directional" ? 2.0 : 1.0) * (ps.env_layout == "cube" ? 1.0 : 2.0);
+    const double per_hit = env_reads + (ps.lut ? 1.0 : 0.0) + (ps.irradiance_cube ? 1.0 : 0.0);
     std::optional<double> instructions;
     if (fragment) {
         FragmentShadingResult f = shade_fragment(gpu, {defs, shade_options, b, pc, uint32_t(scene.spheres.size())});
@@ -113,12 +118,15 @@ RenderResult render_mobile(GpuSession& gpu, const Environment& env, const TestSp
         instructions = shading_instructions_per_pixel(gpu, {"shade_spheres.comp", defs, types, shade_options, b, 5, &pc, sizeof pc, width, height}, out);
     }
     result.shader_instructions_per_pixel = instructions.value_or(0);
+    result.texel_count = ibl.texel_count;
+    result.texture_bytes = ibl.texture_bytes;
     result.provenance = {{"method", "mobile"},
                          {"cost", cost_provenance(instructions, result.texture_fetches_per_pixel)},
                          {"precompute_cached", cached},
                          {"cube_size", ps.cube_size},
                          {"mips", std::min(ps.mips, ibl.full_mips)},
                          {"storage_native", ps.storage != "r11g11b10" || ibl.native_r11g11b10},
+                         {"texture", {{"layout", ps.env_layout}, {"texels", ibl.texel_count}, {"bytes", ibl.texture_bytes}}},
                          {"shader_variant", glsl_selection_names(variant)}};
     if (fp16_path) result.provenance["fp16"] = vk::fp16_path_name(*fp16_path);
     if (fragment) {

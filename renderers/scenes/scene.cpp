@@ -238,13 +238,21 @@ std::vector<SceneInfo> scene_catalog() {
 
 const std::vector<std::string>& scene_option_keys() {
     static const std::vector<std::string> keys = {"roughness", "metallic", "base_color", "frame", "bump_amplitude", "bump_frequency",
-                                                 "roughness_bias", "camera_shift"};
+                                                 "roughness_bias", "camera_shift", "ao"};
     return keys;
 }
 
 namespace {
 // Small perturbations for the stability analysis (issue 9): every sphere's roughness + bias
 // (clamped to [0, 1]) and the camera moved by a fraction of a pixel of the scene's default size.
+// Material AO (option ao) on every sphere of any scene.
+void apply_ao(Scene& s, const OptionMap& o) {
+    if (!o.has("ao")) return;
+    float ao = float(o.get_double("ao", 1.0));
+    if (!(ao >= 0 && ao <= 1)) throw UsageError("option 'ao': " + o.get_string("ao", "") + " is outside [0, 1]");
+    for (Sphere& sp : s.spheres) sp.material.ao = ao;
+}
+
 void apply_perturbations(Scene& s, const OptionMap& o) {
     float bias = float(o.get_double("roughness_bias", 0.0));
     for (Sphere& sp : s.spheres) sp.material.roughness = std::clamp(sp.material.roughness + bias, 0.0f, 1.0f);
@@ -273,6 +281,7 @@ Scene build_scene(const std::string& name, const OptionMap& options) {
         if (name == d.name) {
             Scene s = d.build(options);
             apply_perturbations(s, options);
+            apply_ao(s, options);
             return s;
         }
     std::string valid;

@@ -21,6 +21,10 @@ struct Material {
     Vec3f base_color{1, 1, 1};
     float metallic = 0;
     float roughness = 0.5f; // perceptual; α = r²
+    // Material ambient occlusion (option ao, every sphere): UE4 multiplies the diffuse indirect
+    // lighting and the indirect_irradiance its mobile normalisation reads (seed 001). The mobile
+    // method reads it; the reference and sampled methods refuse the option.
+    float ao = 1.0f;
 };
 
 struct Sphere {

@@ -5,17 +5,21 @@
 //   lod = 0.5·log2(Ωs / Ωp) + 1,  Ωs = 1 / (N · pdf),  Ωp = 4π / (6 · base²),  pdf = D(h) / 4 at n = v.
 // Hammersley points are rotated per texel (random_rotation), which trades banding for noise.
 // Mip 0 is an exact copy of the source (a mirror); mip m ≥ 1 uses roughness lod_to_roughness(m).
+// The destination is a cube level or, for a 2D env_layout, one level of the octahedral or lat-long
+// map with its border (env_layout.glsl): a border texel is computed as the inner texel it copies
+// (same direction, same random rotation), so it holds exactly that texel's value.
 #include "common.glsl"
+#include "env_layout.glsl"
 #include "brdf.glsl"
 #include "mip_mapping.glsl"
 #include "storage.glsl"
 
 layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;
 layout(binding = 0) uniform samplerCube source;   // rgba32f, box-filtered pyramid
-layout(binding = 1, STORAGE_FORMAT) uniform writeonly image2DArray dst;
+layout(binding = 1, STORAGE_FORMAT) uniform writeonly ENV_IMAGE dst;
 layout(push_constant) uniform Push {
     uint mip;
-    uint dst_size;
+    uint dst_size;        // cube: face size; 2D layout: level width
     uint source_size;
     uint sample_count;
     float full_mips;
@@ -25,8 +29,17 @@ layout(push_constant) uniform Push {
 
 void main() {
     uvec3 t = gl_GlobalInvocationID;
+#if ENV_LAYOUT == ENV_LAYOUT_CUBE
     if (t.x >= pc.dst_size || t.y >= pc.dst_size) return;
     vec3 n = cube_texel_direction(t, pc.dst_size);
+    uvec3 seed_texel = t;
+#else
+    uvec2 size = layout_level_size(pc.dst_size);
+    if (t.x >= size.x || t.y >= size.y) return;
+    ivec2 source_texel = layout_source_texel(t.xy, size);
+    vec3 n = layout_texel_direction(source_texel, size);
+    uvec3 seed_texel = uvec3(source_texel, 0u);
+#endif
     vec3 result;
     if (pc.mip == 0u) {
         result = textureLod(source, n, 0.0).rgb;
@@ -34,7 +47,7 @@ void main() {
         float r = lod_to_roughness(float(pc.mip), pc.full_mips, pc.max_lod);
         float alpha = max(r * r, 1e-4);
         float omega_p = 4.0 * PI / (6.0 * float(pc.source_size * pc.source_size));
-        vec2 rot = random_rotation(uvec3(t.xy, t.z + 6u * pc.mip));
+        vec2 rot = random_rotation(uvec3(seed_texel.xy, seed_texel.z + 6u * pc.mip));
         vec3 sum = vec3(0.0);
         float weight = 0.0;
         for (uint i = 0u; i < pc.sample_count; ++i) {
@@ -52,5 +65,9 @@ void main() {
         }
         result = sum / max(weight, 1e-8);
     }
+#if ENV_LAYOUT == ENV_LAYOUT_CUBE
     imageStore(dst, ivec3(t), encode_storage(result));
+#else
+    imageStore(dst, ivec2(t.xy), encode_storage(result));
+#endif
 }

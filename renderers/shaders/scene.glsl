@@ -7,6 +7,9 @@ struct SphereGpu {
     vec4 center_radius;
     vec4 base_color_metallic;
     vec4 roughness_bump;   // roughness, bump amplitude, bump frequency, bump phase
+#ifdef MATERIAL_AO
+    vec4 ao_pad;           // x: material ambient occlusion (option ao); present only when a sphere has one
+#endif
 };
 
 // The camera as scene_camera() returns it (the first four vec4 of SceneBuffer).

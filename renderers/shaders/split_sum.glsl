@@ -11,6 +11,7 @@
 #include "scene.glsl"
 #include "mip_mapping.glsl"
 #include "storage.glsl"
+#include "env_layout.glsl"
 #include "precision.glsl"
 #include "env_brdf.glsl"
 #include "dominant_dir.glsl"
@@ -21,7 +22,7 @@
 #error "DIFFUSE is set from the option table (renderers/option_table.cpp)"
 #endif
 
-layout(binding = 1) uniform samplerCube prefiltered;
+layout(binding = 1) uniform ENV_SAMPLER prefiltered;  // a cube, or a 2D layout (env_layout.glsl)
 layout(binding = 2, std430) readonly buffer SH { vec4 coeffs[10]; } sh;
 layout(binding = 3) uniform sampler2D dfg_lut;
 layout(binding = 4) uniform samplerCube irradiance_cube;
@@ -55,6 +56,11 @@ vec3 shade_surface(SphereGpu s, vec3 n, vec3 v, float roughness) {
     float metallic = s.base_color_metallic.a;
 
     vec3 diffuse_light = diffuse_radiance(n);
+#ifdef MATERIAL_AO
+    // Material AO (option ao): UE4 multiplies the indirect lighting by it, the diffuse and the
+    // indirect_irradiance its normalisation reads alike (seed 001), never the reflection itself.
+    diffuse_light *= s.ao_pad.x;
+#endif
 
     hvec3 hn = hvec3(n), hv = hvec3(v);
     hfloat hr = hfloat(roughness);
@@ -62,7 +68,7 @@ vec3 shade_surface(SphereGpu s, vec3 n, vec3 v, float roughness) {
     hvec3 refl = hfloat(2.0) * dot(hn, hv) * hn - hv;
     vec3 dir = vec3(specular_dominant_dir(hn, refl, hr));
     float lod = roughness_to_lod(roughness, pc.full_mips, pc.max_lod);
-    hvec3 spec_light = hvec3(decode_storage(textureLod(prefiltered, dir, lod)));
+    hvec3 spec_light = hvec3(decode_storage(SAMPLE_ENV(prefiltered, dir, lod)));
 
 #if ENV_BRDF == ENV_BRDF_LUT
     hvec2 ab = hvec2(textureLod(dfg_lut, dfg_lut_uv(float(n_dot_v), roughness, float(textureSize(dfg_lut, 0).x)), 0.0).rg);
@@ -74,7 +80,16 @@ vec3 shade_surface(SphereGpu s, vec3 n, vec3 v, float roughness) {
 
     hfloat indirect = pc.indirect_irradiance >= 0.0 ? hfloat(pc.indirect_irradiance)
                                                     : dot(hvec3(diffuse_light), hvec3(1.0 / 3.0));
+#ifdef MATERIAL_AO
+    if (pc.indirect_irradiance >= 0.0) indirect *= hfloat(s.ao_pad.x);  // from SH9 it has the AO already
+#endif
+#if NORMALIZATION == NORMALIZATION_DIRECTIONAL
+    // The chain's own brightness at n, from its r = 1 level: E(n)/π (mobile_normalization.glsl).
+    hfloat average_brightness = dot(hvec3(decode_storage(SAMPLE_ENV(prefiltered, n, roughness_to_lod(1.0, pc.full_mips, pc.max_lod)))),
+                                    hvec3(1.0 / 3.0));
+#else
     hfloat average_brightness = dot(hvec3(sh.coeffs[9].rgb), hvec3(1.0 / 3.0));
+#endif
     specular *= reflection_mixing_scale(hr, indirect, average_brightness, hfloat(pc.mix_begin_roughness),
                                         hfloat(pc.mix_end_roughness), hfloat(pc.mix_largest_weight));
 

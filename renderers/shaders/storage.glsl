@@ -25,6 +25,12 @@
 #else
 #define STORAGE_FORMAT rgba16f
 #endif
+#elif STORAGE == STORAGE_ASTC_HDR || STORAGE == STORAGE_ASTC_LDR_RGBM
+// ASTC (renderers/mobile/astc_storage.h): the prefilter pass writes the linear radiance in full
+// precision; the host encodes every level with astcenc (RGBM on the host for astc_ldr_rgbm),
+// decodes it as the format specifies (to fp16) and uploads the decoded texels as RGBA16F, which
+// the shading pass filters and decodes below.
+#define STORAGE_FORMAT rgba32f
 #endif
 
 // Rounds a non-negative value to an unsigned float with `mbits` mantissa bits and 5 exponent bits
@@ -52,7 +58,7 @@ vec4 encode_storage(vec3 c) {
 }
 
 vec3 decode_storage(vec4 s) {
-#if STORAGE == STORAGE_RGBM8
+#if STORAGE == STORAGE_RGBM8 || STORAGE == STORAGE_ASTC_LDR_RGBM
     return s.rgb * s.a * RGBM_RANGE;
 #else
     return s.rgb;
