@@ -103,7 +103,9 @@ class FlipEngine {
     // Per-thread buffers, reused across the items a thread computes.
     struct Scratch {
         std::vector<float> rgb, ycc, ring, vacc;
+        std::vector<const float*> src; // tap sources: 2r+1 of them, r grows with ppd
         explicit Scratch(const FlipEngine& e) {
+            src.resize(size_t(2 * e.pad_ + 1));
             const size_t pw = size_t(e.strip_ + 2 * e.pad_);
             rgb.resize(3 * pw);
             ycc.resize(4 * pw);
@@ -147,7 +149,7 @@ class FlipEngine {
             }
             auto run = [&](const float* in, int radius, std::initializer_list<const std::vector<float>*> taps,
                            std::initializer_list<Plane> planes) {
-                const float* src[64];
+                const float** src = s.src.data();
                 const float* tp[3];
                 float* dst[3];
                 const int ntaps = 2 * radius + 1;
@@ -172,7 +174,7 @@ class FlipEngine {
         for (int i = 0; i < 16; ++i) q[i] = s.vacc.data() + size_t(i) * strip_;
         auto column = [&](int img, Plane plane, std::initializer_list<const std::vector<float>*> taps,
                           std::initializer_list<int> slots) {
-            const float* src[64];
+            const float** src = s.src.data();
             const float* tp[3];
             float* dst[3];
             const int ntaps = int((*taps.begin())->size()), r = ntaps / 2;

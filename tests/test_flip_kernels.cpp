@@ -131,14 +131,17 @@ TEST_P(KernelVariants, FlipMatchesScalarBitForBitAtAnyThreadCount) {
     struct Case {
         int w, h;
         bool hdr;
+        double ppd = double(flip::kDefaultPpd);
     };
     // Widths around the 256-column strips and the 8/16/32-pixel blocks; tiny images below the
     // filters' radius; a tall narrow one (row bands when threads > strips).
     for (const Case c : {Case{300, 77, false}, Case{517, 33, true}, Case{7, 9, false}, Case{256, 40, true},
-                         Case{40, 300, false}}) {
+                         Case{40, 300, false},
+                         Case{90, 70, false, 400.0}}) { // 400 ppd: filters of 109 taps
         const cv::Mat a = test_image(c.w, c.h, 1, c.hdr), b = test_image(c.w, c.h, 2, c.hdr);
         FlipOptions ref_opts;
         ref_opts.threads = 1;
+        ref_opts.ppd = c.ppd;
         ref_opts.kernels = &flip::scalar_kernels();
         const FlipResult ref = c.hdr ? compute_flip_hdr(a, b, ref_opts) : compute_flip_ldr(a, b, ref_opts);
         ASSERT_GT(ref.mean, 0.0);
