@@ -44,14 +44,6 @@ struct SrgbLut {
             linear[k] = srgb_to_linear(code[k]);
         }
     }
-    float operator()(float v) const {
-        const float s = v * 255.0f + 0.5f;
-        if (s >= 0.0f && s < 256.0f) {
-            const int k = int(s);
-            if (code[k] == v) return linear[k];
-        }
-        return srgb_to_linear(v);
-    }
 };
 const SrgbLut& srgb_lut() {
     static const SrgbLut lut;
@@ -111,7 +103,9 @@ class FlipEngine {
     // Per-thread buffers, reused across the items a thread computes.
     struct Scratch {
         std::vector<float> rgb, ycc, ring, vacc;
+        std::vector<const float*> src; // tap sources: 2r+1 of them, r grows with ppd
         explicit Scratch(const FlipEngine& e) {
+            src.resize(size_t(2 * e.pad_ + 1));
             const size_t pw = size_t(e.strip_ + 2 * e.pad_);
             rgb.resize(3 * pw);
             ycc.resize(4 * pw);
@@ -155,7 +149,7 @@ class FlipEngine {
             }
             auto run = [&](const float* in, int radius, std::initializer_list<const std::vector<float>*> taps,
                            std::initializer_list<Plane> planes) {
-                const float* src[64];
+                const float** src = s.src.data();
                 const float* tp[3];
                 float* dst[3];
                 const int ntaps = 2 * radius + 1;
@@ -180,7 +174,7 @@ class FlipEngine {
         for (int i = 0; i < 16; ++i) q[i] = s.vacc.data() + size_t(i) * strip_;
         auto column = [&](int img, Plane plane, std::initializer_list<const std::vector<float>*> taps,
                           std::initializer_list<int> slots) {
-            const float* src[64];
+            const float** src = s.src.data();
             const float* tp[3];
             float* dst[3];
             const int ntaps = int((*taps.begin())->size()), r = ntaps / 2;
@@ -265,15 +259,19 @@ FlipResult compute_flip_ldr(const cv::Mat& ref_srgb, const cv::Mat& test_srgb, c
     r.mode = "ldr";
     r.ppd = ppd;
     r.errmap.create(h, w, CV_32F);
-    FlipEngine engine(w, h, ppd, opts.threads, opts.kernels ? *opts.kernels : default_kernels());
+    const Kernels& kern = opts.kernels ? *opts.kernels : default_kernels();
+    FlipEngine engine(w, h, ppd, opts.threads, kern);
     const SrgbLut& lut = srgb_lut();
     const cv::Mat* imgs[2] = {&ref_srgb, &test_srgb};
     auto prep = [&](int img, int y, int x0, int x1, float* R, float* G, float* B) {
         const float* p = imgs[img]->ptr<float>(y) + 3 * x0;
-        for (int i = 0; i < x1 - x0; ++i, p += 3) {
-            R[i] = clamp01(lut(p[0]));
-            G[i] = clamp01(lut(p[1]));
-            B[i] = clamp01(lut(p[2]));
+        const int n = x1 - x0;
+        kern.srgb_to_linear(p, n, lut.code.data(), lut.linear.data(), R, G, B);
+        // Values that are not 8-bit codes (-1 from the table): the formula.
+        for (int i = 0; i < n; ++i) {
+            if (R[i] < 0.0f) R[i] = clamp01(srgb_to_linear(p[3 * i]));
+            if (G[i] < 0.0f) G[i] = clamp01(srgb_to_linear(p[3 * i + 1]));
+            if (B[i] < 0.0f) B[i] = clamp01(srgb_to_linear(p[3 * i + 2]));
         }
     };
     engine.evaluate(prep, r.errmap.ptr<float>(), false);
@@ -330,7 +328,8 @@ FlipResult compute_flip_hdr(const cv::Mat& ref_linear, const cv::Mat& test_linea
     // Not cv::Mat::zeros: its MatExpr goes through a lazily built OpenCV singleton that TSan sees
     // racing between the runner's workers.
     r.errmap = cv::Mat(h, w, CV_32F, cv::Scalar(0));
-    FlipEngine engine(w, h, ppd, opts.threads, opts.kernels ? *opts.kernels : default_kernels());
+    const Kernels& kern = opts.kernels ? *opts.kernels : default_kernels();
+    FlipEngine engine(w, h, ppd, opts.threads, kern);
     const cv::Mat* imgs[2] = {&ref_linear, &test_linear};
     const float step = (stop - start) / float(num - 1);
     const ToneMapper tm = opts.tone_mapper;
@@ -338,14 +337,7 @@ FlipResult compute_flip_hdr(const cv::Mat& ref_linear, const cv::Mat& test_linea
         const float exposure = start + float(i) * step;
         const float m = std::pow(2.0f, exposure);
         auto prep = [&](int img, int y, int x0, int x1, float* R, float* G, float* B) {
-            const float* p = imgs[img]->ptr<float>(y) + 3 * x0;
-            for (int i = 0; i < x1 - x0; ++i, p += 3) {
-                float cr = p[0] * m, cg = p[1] * m, cb = p[2] * m;
-                tone_map(tm, cr, cg, cb);
-                R[i] = clamp01(cr);
-                G[i] = clamp01(cg);
-                B[i] = clamp01(cb);
-            }
+            kern.expose_tone_map(imgs[img]->ptr<float>(y) + 3 * x0, x1 - x0, m, tm, R, G, B);
         };
         engine.evaluate(prep, r.errmap.ptr<float>(), true);
     }
@@ -381,9 +373,10 @@ void pool_flip_errmap(FlipResult& r) {
     r.max = mx;
     if (negative) std::sort(values.begin(), values.end()); // not a FLIP map; stay correct
     else radix_sort_nonnegative(values);
-    r.weighted_median = weighted_percentile_sorted(values, sum_float, 0.5f);
-    r.weighted_q1 = weighted_percentile_sorted(values, sum_float, 0.25f);
-    r.weighted_q3 = weighted_percentile_sorted(values, sum_float, 0.75f);
+    const auto wp = weighted_percentiles_sorted<3>(values, sum_float, {0.5f, 0.25f, 0.75f});
+    r.weighted_median = wp[0];
+    r.weighted_q1 = wp[1];
+    r.weighted_q3 = wp[2];
     // Nearest-rank 99th percentile.
     const size_t rank = std::min(n - 1, size_t(std::ceil(0.99 * double(n))) - 1);
     r.p99 = values[rank];

@@ -11,7 +11,7 @@
 // shared FLIP vectors (../shared/flip-vectors) are present, their 1080p pairs are measured too, and
 // NVIDIA's tool's timings stored there are printed as context: they were taken on another run and
 // are never divided into a ratio here.
-//   build/metrics/bench_metrics [--benchmark_filter=...] [--benchmark_repetitions=N]
+//   cmake --build build --target bench_metrics && build/metrics/bench_metrics [--benchmark_filter=...]
 #include <benchmark/benchmark.h>
 #include <fcntl.h>
 #include <spawn.h>

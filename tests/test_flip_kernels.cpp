@@ -4,6 +4,8 @@
 // depend on the CI machine's SIMD width).
 #include <gtest/gtest.h>
 
+#include <array>
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -13,6 +15,7 @@
 #include "harness/common/errors.h"
 #include "metrics/flip.h"
 #include "metrics/flip/kernels.h"
+#include "metrics/flip/pooling.h"
 
 using namespace iblcheck;
 
@@ -83,6 +86,23 @@ TEST_P(KernelVariants, PixelMathMatchesScalarBitForBit) {
     k.rgb_to_ycxcz(r.data(), g.data(), b.data(), n, &o1[0], &o1[n], &o1[2 * n], &o1[3 * n]);
     ref.rgb_to_ycxcz(r.data(), g.data(), b.data(), n, &o2[0], &o2[n], &o2[2 * n], &o2[3 * n]);
     EXPECT_TRUE(same_bits(o1.data(), o2.data(), o1.size())) << k.name;
+    // sRGB codes through the table: exact codes k/255, values that are not (misses give -1), NaN,
+    // out of range; and HDR exposure + tone mapping with each tone mapper.
+    std::vector<float> rgb = random_values(3 * n, 4, -0.2f, 1.2f);
+    for (int i = 0; i < 3 * n; i += 2) rgb[size_t(i)] = float(i % 256) / 255.0f;
+    rgb[5] = std::numeric_limits<float>::quiet_NaN();
+    rgb[7] = -0.0f;
+    std::array<float, 256> code, linear;
+    for (int i = 0; i < 256; ++i) code[size_t(i)] = float(i) / 255.0f, linear[size_t(i)] = 0.001f * float(i * i) - 0.01f;
+    k.srgb_to_linear(rgb.data(), n, code.data(), linear.data(), &o1[0], &o1[n], &o1[2 * n]);
+    ref.srgb_to_linear(rgb.data(), n, code.data(), linear.data(), &o2[0], &o2[n], &o2[2 * n]);
+    EXPECT_TRUE(same_bits(o1.data(), o2.data(), size_t(3 * n))) << k.name << " srgb_to_linear";
+    const std::vector<float> radiance = random_values(3 * n, 5, 0.0f, 300.0f);
+    for (auto tm : {flip::ToneMapper::aces, flip::ToneMapper::hable, flip::ToneMapper::reinhard}) {
+        k.expose_tone_map(radiance.data(), n, 0.37f, tm, &o1[0], &o1[n], &o1[2 * n]);
+        ref.expose_tone_map(radiance.data(), n, 0.37f, tm, &o2[0], &o2[n], &o2[2 * n]);
+        EXPECT_TRUE(same_bits(o1.data(), o2.data(), size_t(3 * n))) << k.name << " tone mapper " << int(tm);
+    }
     // FLIP per pixel from filtered planes: realistic ranges (Y around 0..100, chroma +-100,
     // derivatives +-1), plus zeros and identical reference/test values.
     std::vector<std::vector<float>> planes(16);
@@ -111,14 +131,17 @@ TEST_P(KernelVariants, FlipMatchesScalarBitForBitAtAnyThreadCount) {
     struct Case {
         int w, h;
         bool hdr;
+        double ppd = double(flip::kDefaultPpd);
     };
     // Widths around the 256-column strips and the 8/16/32-pixel blocks; tiny images below the
     // filters' radius; a tall narrow one (row bands when threads > strips).
     for (const Case c : {Case{300, 77, false}, Case{517, 33, true}, Case{7, 9, false}, Case{256, 40, true},
-                         Case{40, 300, false}}) {
+                         Case{40, 300, false},
+                         Case{90, 70, false, 400.0}}) { // 400 ppd: filters of 109 taps
         const cv::Mat a = test_image(c.w, c.h, 1, c.hdr), b = test_image(c.w, c.h, 2, c.hdr);
         FlipOptions ref_opts;
         ref_opts.threads = 1;
+        ref_opts.ppd = c.ppd;
         ref_opts.kernels = &flip::scalar_kernels();
         const FlipResult ref = c.hdr ? compute_flip_hdr(a, b, ref_opts) : compute_flip_ldr(a, b, ref_opts);
         ASSERT_GT(ref.mean, 0.0);
@@ -151,6 +174,32 @@ TEST(KernelSelection, NamesAndDefault) {
     // The default is the fastest this CPU runs (unless IBLCHECK_FLIP_KERNELS says otherwise).
     if (!std::getenv("IBLCHECK_FLIP_KERNELS")) {
         EXPECT_STREQ(flip::default_kernels().name, flip::cpu_has_avx2() ? "avx2" : "sse2");
+    }
+}
+
+} // namespace
+
+namespace {
+
+// Pooling (flip/pooling.h): the one-pass weighted percentiles equal one scan per fraction, and the
+// radix sort equals std::sort.
+TEST(Pooling, OnePassPercentilesEqualOneScanEach) {
+    std::mt19937 rng(7);
+    for (int trial = 0; trial < 50; ++trial) {
+        std::vector<float> v(size_t(1 + rng() % 3000));
+        std::uniform_real_distribution<float> u(0.0f, 1.0f);
+        for (auto& x : v) x = trial % 5 == 0 ? 0.0f : (rng() % 4 == 0 ? 0.5f : u(rng)); // zeros, ties
+        std::vector<float> sorted = v;
+        flip::radix_sort_nonnegative(sorted);
+        std::vector<float> expected = v;
+        std::sort(expected.begin(), expected.end());
+        ASSERT_TRUE(same_bits(sorted.data(), expected.data(), v.size()));
+        float total = 0.0f;
+        for (float x : v) total += x;
+        const auto all = flip::weighted_percentiles_sorted<3>(sorted, total, {0.5f, 0.25f, 0.75f});
+        EXPECT_EQ(all[0], flip::weighted_percentile_sorted(sorted, total, 0.5f));
+        EXPECT_EQ(all[1], flip::weighted_percentile_sorted(sorted, total, 0.25f));
+        EXPECT_EQ(all[2], flip::weighted_percentile_sorted(sorted, total, 0.75f));
     }
 }
 

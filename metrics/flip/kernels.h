@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "metrics/flip/tone_mappers.h"
+
 namespace iblcheck::flip {
 
 struct Kernels {
@@ -18,6 +20,12 @@ struct Kernels {
     // out[f][x] = sum over k ascending of taps[f][k] * src[k][x], for nf filters (1..3) sharing the
     // same sources; the first term is 0 + taps[f][0] * src[0][x] (the reference tool's tap order).
     void (*fir)(const float* const* src, const float* const* taps, int nf, int ntaps, int n, float* const* out);
+    // Interleaved RGB of an 8-bit sRGB image (values k/255) -> linear planes, clamped to [0,1],
+    // through the 256-entry tables; a value that is not k/255 gives -1 (the caller applies the formula).
+    void (*srgb_to_linear)(const float* rgb, int n, const float* code, const float* linear, float* r, float* g,
+                           float* b);
+    // Interleaved linear RGB -> planes of HDR-FLIP's input for one exposure: * m, tone mapped, clamped.
+    void (*expose_tone_map)(const float* rgb, int n, float m, ToneMapper tm, float* r, float* g, float* b);
     // Linear RGB -> YCxCz (Y, Cx, Cz) and the feature channel Yn = Y / 116 + 16 / 116.
     void (*rgb_to_ycxcz)(const float* r, const float* g, const float* b, int n, float* y, float* cx, float* cz,
                          float* yn);

@@ -6,12 +6,35 @@
 #include "metrics/flip/color_spaces.h"
 #include "metrics/flip/fast_math.h"
 #include "metrics/flip/flip_constants.h"
+#include "metrics/flip/tone_mappers.h"
 
 namespace iblcheck::flip::pixel {
 
 // std::max(v, lo) and std::min(v, hi), spelled out (same results, NaN included).
 IBLCHECK_FLIP_INLINE float max_of(float v, float lo) { return v < lo ? lo : v; }
 IBLCHECK_FLIP_INLINE float min_of(float v, float hi) { return hi < v ? hi : v; }
+
+// std::min(std::max(v, 0), 1).
+IBLCHECK_FLIP_INLINE float clamp01(float v) { return min_of(max_of(v, 0.0f), 1.0f); }
+
+// An 8-bit sRGB code k/255 -> linear through the 256-entry table (code[k] = k/255, linear[k] its
+// linear value); -1 when v is not exactly such a code (the caller computes those with the formula).
+IBLCHECK_FLIP_INLINE float srgb_code_to_linear(float v, const float* code, const float* linear) {
+    float s = v * 255.0f + 0.5f;
+    s = s >= 0.0f && s < 256.0f ? s : 0.0f; // NaN too: index 0, then a miss
+    const int k = int(s);
+    const float c = code[k], l = linear[k]; // both loads unconditional: the loop vectorises (gathers)
+    return c == v ? clamp01(l) : -1.0f;
+}
+
+// HDR-FLIP's input for one exposure: radiance * 2^exposure, tone mapped, clamped to [0,1].
+IBLCHECK_FLIP_INLINE void expose_tone_map(const float* p, float m, ToneMapper tm, float& R, float& G, float& B) {
+    float cr = p[0] * m, cg = p[1] * m, cb = p[2] * m;
+    tone_map(tm, cr, cg, cb);
+    R = clamp01(cr);
+    G = clamp01(cg);
+    B = clamp01(cb);
+}
 
 // Linear RGB -> YCxCz and the feature channel Y normalised to [0,1] (FLIP paper, Sec. 4.2).
 IBLCHECK_FLIP_INLINE void rgb_to_ycxcz(float r, float g, float b, float& Y, float& Cx, float& Cz, float& Yn) {

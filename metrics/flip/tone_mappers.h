@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "harness/common/errors.h"
+#include "metrics/flip/fast_math.h"
 #include "metrics/flip/flip_constants.h"
 
 namespace iblcheck::flip {
@@ -39,12 +40,12 @@ inline const char* tone_mapper_name(ToneMapper tm) {
 }
 
 // One channel of the rational curve (not Reinhard).
-inline float tone_map_channel(float c, const float* k) {
+IBLCHECK_FLIP_INLINE float tone_map_channel(float c, const float* k) {
     return ((c * c) * k[0] + c * k[1] + k[2]) / ((c * c) * k[3] + c * k[4] + k[5]);
 }
 
 // Tone-maps one linear RGB pixel in place.
-inline void tone_map(ToneMapper tm, float& r, float& g, float& b) {
+IBLCHECK_FLIP_INLINE void tone_map(ToneMapper tm, float& r, float& g, float& b) {
     if (tm == ToneMapper::reinhard) {
         const float lum = 0.2126f * r + 0.7152f * g + 0.0722f * b;
         const float factor = 1.0f / (1.0f + lum);
