@@ -5,6 +5,7 @@
 #include <cstring>
 
 #include "astc_storage.h"
+#include "descriptor_types.h"
 #include "env_layout.h"
 #include "harness/common/errors.h"
 #include "renderers/option_table.h"
@@ -13,9 +14,6 @@ namespace iblcheck {
 
 namespace {
 
-constexpr VkDescriptorType kSampled = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
-constexpr VkDescriptorType kStorageImage = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
-constexpr VkDescriptorType kStorageBuffer = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
 
 uint32_t groups(uint32_t n, uint32_t local = 8) { return (n + local - 1) / local; }
 
