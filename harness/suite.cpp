@@ -8,6 +8,7 @@
 #include <set>
 
 #include "harness/common/errors.h"
+#include "harness/common/json_check.h"
 #include "renderers/option_table.h"
 #include "renderers/renderer.h"
 
@@ -20,32 +21,9 @@ namespace {
 
 const std::set<std::string> kMetrics = {"flip.mean", "flip.p99", "flip.block_max", "ssim.mean", "psnr.db"};
 
-struct Ctx {
-    std::string file;
-    [[noreturn]] void fail(const std::string& where, const std::string& problem) const {
-        throw InputError(file + ": " + where + ": " + problem);
-    }
-    void keys(const json& j, const std::string& where, const std::set<std::string>& allowed) const {
-        if (!j.is_object()) fail(where, "must be an object");
-        for (auto& [k, v] : j.items())
-            if (!allowed.count(k)) {
-                std::string list;
-                for (auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-                fail(where + "." + k, "unknown key; valid: " + list);
-            }
-    }
-    std::string str(const json& j, const std::string& where) const {
-        if (!j.is_string()) fail(where, "must be a string");
-        return j.get<std::string>();
-    }
-    double num(const json& j, const std::string& where) const {
-        if (!j.is_number()) fail(where, "must be a number");
-        return j.get<double>();
-    }
-    bool boolean(const json& j, const std::string& where) const {
-        if (!j.is_boolean()) fail(where, "must be true or false");
-        return j.get<bool>();
-    }
+// The suite reader's checks: the shared ones (harness/common/json_check.h) plus options and bounds.
+struct Ctx : JsonChecker {
+    using JsonChecker::JsonChecker;
     // Option values are written as strings or numbers; both become the CLI's text form.
     std::string option_value(const json& j, const std::string& where) const {
         if (j.is_string()) return j.get<std::string>();

@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "harness/common/errors.h"
+#include "harness/common/json_check.h"
 #include "reports/report_writer.h"
 
 namespace iblcheck::report {
@@ -16,13 +17,10 @@ namespace {
 
 using json = nlohmann::json;
 
-struct Checker {
-    std::string source;
-
-    [[noreturn]] void fail(const std::string& where, const std::string& problem) const {
-        throw InputError(fmt::format("{}: {}{}{}", source, where, where.empty() ? "" : ": ", problem));
-    }
-    const char* type_name(const json& j) const { return j.type_name(); }
+// The results reader's checks: keys of objects, by type (harness/common/json_check.h), and the
+// arrays and maps of one type the results hold.
+struct Checker : JsonChecker {
+    using JsonChecker::JsonChecker;
 
     const json& require(const json& obj, const std::string& where, const char* key) const {
         auto it = obj.find(key);
@@ -30,45 +28,27 @@ struct Checker {
         return *it;
     }
     void string_(const json& obj, const std::string& where, const char* key, bool required = false) const {
-        auto it = obj.find(key);
-        if (it == obj.end() || it->is_null()) {
-            if (required) fail(where, fmt::format("missing key '{}'", key));
-            return;
-        }
-        if (!it->is_string()) fail(where, fmt::format("'{}' must be a string, not {}", key, type_name(*it)));
+        member(obj, where, key, JsonType::string, required);
     }
     void number(const json& obj, const std::string& where, const char* key, bool required = false) const {
-        auto it = obj.find(key);
-        if (it == obj.end() || it->is_null()) {
-            if (required) fail(where, fmt::format("missing key '{}'", key));
-            return;
-        }
-        if (!it->is_number()) fail(where, fmt::format("'{}' must be a number, not {}", key, type_name(*it)));
+        member(obj, where, key, JsonType::number, required);
     }
     void boolean(const json& obj, const std::string& where, const char* key) const {
-        auto it = obj.find(key);
-        if (it == obj.end() || it->is_null()) return;
-        if (!it->is_boolean()) fail(where, fmt::format("'{}' must be true or false, not {}", key, type_name(*it)));
+        member(obj, where, key, JsonType::boolean);
     }
-    // Returns nullptr when absent or null.
+    // Return nullptr when absent or null.
     const json* object(const json& obj, const std::string& where, const char* key) const {
-        auto it = obj.find(key);
-        if (it == obj.end() || it->is_null()) return nullptr;
-        if (!it->is_object()) fail(where, fmt::format("'{}' must be an object, not {}", key, type_name(*it)));
-        return &*it;
+        return member(obj, where, key, JsonType::object);
     }
     const json* array(const json& obj, const std::string& where, const char* key) const {
-        auto it = obj.find(key);
-        if (it == obj.end() || it->is_null()) return nullptr;
-        if (!it->is_array()) fail(where, fmt::format("'{}' must be an array, not {}", key, type_name(*it)));
-        return &*it;
+        return member(obj, where, key, JsonType::array);
     }
     void string_array(const json& obj, const std::string& where, const char* key) const {
         if (const json* a = array(obj, where, key))
             for (size_t i = 0; i < a->size(); ++i)
                 if (!(*a)[i].is_string())
                     fail(where, fmt::format("'{}[{}]' must be a string (an image path), not {}", key, i,
-                                            type_name((*a)[i])));
+                                            (*a)[i].type_name()));
     }
     void number_map(const json& obj, const std::string& where, const char* key) const {
         if (const json* m = object(obj, where, key))
