@@ -256,7 +256,7 @@ std::string legend_html(Markers& markers, const std::set<std::string>& methods) 
 
 } // namespace
 
-std::string charts_html(const std::vector<const json*>& tests, const std::vector<size_t>& order) {
+std::string charts_html(const std::vector<const json*>& tests) {
     std::string o;
     auto out = std::back_inserter(o);
     // Groups of one scene and environment, largest first.
@@ -274,7 +274,7 @@ std::string charts_html(const std::vector<const json*>& tests, const std::vector
         std::vector<size_t> page;
         for (size_t i : idx) {
             gt.push_back(tests[i]);
-            page.push_back(order[i]);
+            page.push_back(i);
             methods.insert(str(*tests[i], "method"));
         }
         cost += cost_panel("cost-accuracy-" + slug(g), g, gt, page, markers);
@@ -332,7 +332,7 @@ std::string charts_html(const std::vector<const json*>& tests, const std::vector
             std::vector<size_t> page;
             for (size_t i : idx) {
                 members.push_back(tests[i]);
-                page.push_back(order[i]);
+                page.push_back(i);
             }
             row += roughness_panel("error-roughness-" + slug(g) + "-" + slug(fam), fam, members, page);
         };
@@ -346,7 +346,7 @@ std::string charts_html(const std::vector<const json*>& tests, const std::vector
                 std::vector<size_t> page;
                 for (size_t i : d) {
                     members.push_back(tests[i]);
-                    page.push_back(order[i]);
+                    page.push_back(i);
                 }
                 row += roughness_panel("error-roughness-" + slug(g), g, members, page);
             }
@@ -390,7 +390,7 @@ std::string charts_html(const std::vector<const json*>& tests, const std::vector
         p.y = *fl;
         p.label = test_label(t) + " \u00b7 " + str(t, "env");  // method, variant and environment
         p.tooltip = fmt::format("{}\nFLIP = {}, flicker = {}", str(t, "name"), fmt_num(*fm), fmt_num(*fl));
-        p.href = "#" + test_id(order[i]);
+        p.href = "#" + test_id(i);
         it->points.push_back(std::move(p));
     }
     if (flick.empty()) o += "<p class=\"meta\">No temporal test in this run.</p>\n";

@@ -74,7 +74,7 @@ void test_card(std::string& o, const json& t, size_t idx, PageContext& ctx, cons
 void test_tile(std::string& o, const json& t, size_t idx, PageContext& ctx);
 
 // The charts tab: cost against accuracy, wall time (median and range), error against roughness,
-// flicker against FLIP, each as small multiples. `order[i]` is the page index of tests[i].
-std::string charts_html(const std::vector<const json*>& tests, const std::vector<size_t>& order);
+// flicker against FLIP, each as small multiples. tests[i] is the page's test i (its id test_id(i)).
+std::string charts_html(const std::vector<const json*>& tests);
 
 } // namespace iblcheck::report::html

@@ -210,8 +210,6 @@ void write_report(const json& results, const fs::path& results_dir, const fs::pa
     std::stable_sort(tests.begin(), tests.end(), [](const json* a, const json* b) {
         return verdict_rank(str(*a, "verdict")) < verdict_rank(str(*b, "verdict"));
     });
-    std::vector<size_t> order(tests.size());
-    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
 
     std::map<std::string, int> counts;
     for (auto& v : verdict_order()) counts[v] = 0;
@@ -353,7 +351,7 @@ void write_report(const json& results, const fs::path& results_dir, const fs::pa
     o += "</section>\n";
 
     // ---- Charts ----
-    o += "<section class=\"tab\" id=\"tab-charts\">\n" + charts_html(tests, order) + "</section>\n";
+    o += "<section class=\"tab\" id=\"tab-charts\">\n" + charts_html(tests) + "</section>\n";
 
     // ---- History ----
     o += "<section class=\"tab\" id=\"tab-history\">\n<h2>History</h2>\n";
