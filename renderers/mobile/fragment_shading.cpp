@@ -3,13 +3,12 @@
 #include <cstring>
 
 #include "harness/common/errors.h"
+#include "renderers/mobile/descriptor_types.h"
 #include "renderers/vulkan/spirv_cost.h"
 
 namespace iblcheck {
 
 namespace {
-constexpr VkDescriptorType kSampled = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
-constexpr VkDescriptorType kStorageBuffer = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
 const std::vector<VkDescriptorType> kTypes = {kStorageBuffer, kSampled, kStorageBuffer, kSampled, kSampled};
 constexpr uint32_t kQuadVertices = 4;  // a triangle strip per sphere
 

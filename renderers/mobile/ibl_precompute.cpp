@@ -7,15 +7,12 @@
 #include "astc_storage.h"
 #include "env_layout.h"
 #include "harness/common/errors.h"
+#include "renderers/mobile/descriptor_types.h"
 #include "renderers/option_table.h"
 
 namespace iblcheck {
 
 namespace {
-
-constexpr VkDescriptorType kSampled = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
-constexpr VkDescriptorType kStorageImage = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
-constexpr VkDescriptorType kStorageBuffer = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
 
 uint32_t groups(uint32_t n, uint32_t local = 8) { return (n + local - 1) / local; }
 

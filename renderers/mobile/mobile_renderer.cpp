@@ -5,6 +5,7 @@
 
 #include "gpu_scene.h"
 #include "harness/common/errors.h"
+#include "renderers/mobile/descriptor_types.h"
 #include "renderers/option_table.h"
 #include "ibl_precompute.h"
 #include "renderers/scenes/scene.h"
@@ -13,12 +14,6 @@
 #include "renderers/vulkan/fp16_emulation.h"
 
 namespace iblcheck {
-
-namespace {
-constexpr VkDescriptorType kSampled = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
-constexpr VkDescriptorType kStorageBuffer = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-
-} // namespace
 
 RenderResult render_mobile(GpuSession& gpu, const Environment& env, const TestSpec& spec) {
     const OptionMap& o = spec.options;
