@@ -1,9 +1,10 @@
 // `--method sampled`: see shaders/shade_sampled.comp for the estimator. It shares the source
 // pyramid and SH9 passes with the mobile pipeline and skips the prefiltered chain.
+#include "sampled_renderer.h"
+
 #include "harness/common/errors.h"
 #include "renderers/mobile/gpu_scene.h"
 #include "renderers/mobile/ibl_precompute.h"
-#include "renderers/mobile/mobile_renderer.h"
 #include "renderers/mobile/push_constants.h"
 #include "renderers/mobile/shading_cost.h"
 
