@@ -63,82 +63,47 @@ const std::set<std::string>& verdicts() {
     return v;
 }
 
-void check_test(const Checker& c, const json& t, size_t i) {
-    std::string where = fmt::format("tests[{}]", i);
-    if (!t.is_object()) c.fail(where, fmt::format("must be an object, not {}", t.type_name()));
-    c.string_(t, where, "name", true);
-    where = fmt::format("tests[{}] ({})", i, t["name"].get<std::string>());
-    c.string_(t, where, "verdict", true);
-    const std::string verdict = t["verdict"].get<std::string>();
-    if (!verdicts().count(verdict))
-        c.fail(where, fmt::format("verdict '{}' is not one of pass, fail, improved, missing-golden, error", verdict));
-    for (const char* k : {"suite", "scene", "method", "env", "variant", "message", "bless_command", "driver_mismatch", "image",
-                          "image_exr"})
-        c.string_(t, where, k);
-    for (const char* k : {"width", "height", "precompute_ms", "frame_ms", "texture_fetches_per_pixel", "texture_bytes", "texel_count"})
-        c.number(t, where, k);
-    c.number_map(t, where, "cost");
-    if (const json* smp = c.array(t, where, "frame_ms_samples"))
-        for (size_t k = 0; k < smp->size(); ++k)
-            if (!(*smp)[k].is_number())
-                c.fail(where, fmt::format("'frame_ms_samples[{}]' must be a number, not {}", k, (*smp)[k].type_name()));
-    if (const json* lay = c.object(t, where, "layout")) {
-        c.string_(*lay, where + ": layout", "id_map");
-        if (const json* sp = c.array(*lay, where + ": layout", "spheres"))
-            for (size_t k = 0; k < sp->size(); ++k) {
-                const std::string sw = fmt::format("{}: layout.spheres[{}]", where, k);
-                if (!(*sp)[k].is_object()) c.fail(sw, fmt::format("must be an object, not {}", (*sp)[k].type_name()));
-                c.string_((*sp)[k], sw, "label");
-                c.number((*sp)[k], sw, "roughness");
-                c.number((*sp)[k], sw, "metallic");
-            }
-    }
-    if (const json* o = c.object(t, where, "options"))
-        for (auto& [k, v] : o->items())
-            if (v.is_object() || v.is_array())
-                c.fail(where, fmt::format("options.{} must be a plain value, not {}", k, v.type_name()));
-
-    if (const json* comps = c.array(t, where, "comparisons")) {
-        for (size_t ci = 0; ci < comps->size(); ++ci) {
-            const json& cmp = (*comps)[ci];
-            const std::string cw = fmt::format("{}: comparisons[{}]", where, ci);
-            if (!cmp.is_object()) c.fail(cw, fmt::format("must be an object, not {}", cmp.type_name()));
-            c.string_(cmp, cw, "kind", true);
-            c.string_(cmp, cw, "golden");
-            c.string_(cmp, cw, "verdict");
-            c.string_(cmp, cw, "message");
-            c.string_(cmp, cw, "label");
-            if (const json* m = c.object(cmp, cw, "metrics"))
-                for (auto& [name, group] : m->items()) {
-                    if (!group.is_object() && !group.is_null())
-                        c.fail(cw, fmt::format("metrics.{} must be an object, not {}", name, group.type_name()));
-                }
-            if (const json* checks = c.array(cmp, cw, "checks"))
-                for (size_t k = 0; k < checks->size(); ++k) {
-                    const json& ck = (*checks)[k];
-                    const std::string kw = fmt::format("{}: checks[{}]", cw, k);
-                    if (!ck.is_object()) c.fail(kw, fmt::format("must be an object, not {}", ck.type_name()));
-                    c.string_(ck, kw, "metric", true);
-                    c.number(ck, kw, "value");
-                    c.number(ck, kw, "min");
-                    c.number(ck, kw, "max");
-                    c.number(ck, kw, "approved");
-                    c.string_(ck, kw, "status");
-                }
-            if (const json* wb = c.object(cmp, cw, "worst_block")) {
-                for (const char* k : {"x", "y", "flip"}) c.number(*wb, cw + ": worst_block", k);
-                c.string_(*wb, cw + ": worst_block", "sphere");
-            }
-            if (const json* ap = c.object(cmp, cw, "approved"))
-                for (auto& [k, v] : ap->items())
-                    if (!v.is_string() && !v.is_null())
-                        c.fail(cw, fmt::format("approved.{} must be a string, not {}", k, v.type_name()));
-            if (const json* imgs = c.object(cmp, cw, "images"))
-                for (auto& [k, v] : imgs->items())
-                    if (!v.is_string() && !v.is_null())
-                        c.fail(cw, fmt::format("images.{} must be a string (an image path), not {}", k, v.type_name()));
+// One entry of a test's "comparisons": its kind, metrics, checks, worst block and images.
+void check_comparison(const Checker& c, const json& cmp, const std::string& cw) {
+    if (!cmp.is_object()) c.fail(cw, fmt::format("must be an object, not {}", cmp.type_name()));
+    c.string_(cmp, cw, "kind", true);
+    c.string_(cmp, cw, "golden");
+    c.string_(cmp, cw, "verdict");
+    c.string_(cmp, cw, "message");
+    c.string_(cmp, cw, "label");
+    if (const json* m = c.object(cmp, cw, "metrics"))
+        for (auto& [name, group] : m->items()) {
+            if (!group.is_object() && !group.is_null())
+                c.fail(cw, fmt::format("metrics.{} must be an object, not {}", name, group.type_name()));
         }
+    if (const json* checks = c.array(cmp, cw, "checks"))
+        for (size_t k = 0; k < checks->size(); ++k) {
+            const json& ck = (*checks)[k];
+            const std::string kw = fmt::format("{}: checks[{}]", cw, k);
+            if (!ck.is_object()) c.fail(kw, fmt::format("must be an object, not {}", ck.type_name()));
+            c.string_(ck, kw, "metric", true);
+            c.number(ck, kw, "value");
+            c.number(ck, kw, "min");
+            c.number(ck, kw, "max");
+            c.number(ck, kw, "approved");
+            c.string_(ck, kw, "status");
+        }
+    if (const json* wb = c.object(cmp, cw, "worst_block")) {
+        for (const char* k : {"x", "y", "flip"}) c.number(*wb, cw + ": worst_block", k);
+        c.string_(*wb, cw + ": worst_block", "sphere");
     }
+    if (const json* ap = c.object(cmp, cw, "approved"))
+        for (auto& [k, v] : ap->items())
+            if (!v.is_string() && !v.is_null())
+                c.fail(cw, fmt::format("approved.{} must be a string, not {}", k, v.type_name()));
+    if (const json* imgs = c.object(cmp, cw, "images"))
+        for (auto& [k, v] : imgs->items())
+            if (!v.is_string() && !v.is_null())
+                c.fail(cw, fmt::format("images.{} must be a string (an image path), not {}", k, v.type_name()));
+}
+
+// What a test measured: its pass timings, accuracy, per-sphere errors, temporal and stability figures.
+void check_measurements(const Checker& c, const json& t, const std::string& where) {
     if (const json* tim = c.array(t, where, "timings"))
         for (size_t k = 0; k < tim->size(); ++k) {
             const json& p = (*tim)[k];
@@ -175,6 +140,47 @@ void check_test(const Checker& c, const json& t, size_t i) {
         c.number_map(*st, sw, "margins");
         c.boolean(*st, sw, "flaky");
     }
+}
+
+void check_test(const Checker& c, const json& t, size_t i) {
+    std::string where = fmt::format("tests[{}]", i);
+    if (!t.is_object()) c.fail(where, fmt::format("must be an object, not {}", t.type_name()));
+    c.string_(t, where, "name", true);
+    where = fmt::format("tests[{}] ({})", i, t["name"].get<std::string>());
+    c.string_(t, where, "verdict", true);
+    const std::string verdict = t["verdict"].get<std::string>();
+    if (!verdicts().count(verdict))
+        c.fail(where, fmt::format("verdict '{}' is not one of pass, fail, improved, missing-golden, error", verdict));
+    for (const char* k : {"suite", "scene", "method", "env", "variant", "message", "bless_command", "driver_mismatch", "image",
+                          "image_exr"})
+        c.string_(t, where, k);
+    for (const char* k : {"width", "height", "precompute_ms", "frame_ms", "texture_fetches_per_pixel", "texture_bytes", "texel_count"})
+        c.number(t, where, k);
+    c.number_map(t, where, "cost");
+    if (const json* smp = c.array(t, where, "frame_ms_samples"))
+        for (size_t k = 0; k < smp->size(); ++k)
+            if (!(*smp)[k].is_number())
+                c.fail(where, fmt::format("'frame_ms_samples[{}]' must be a number, not {}", k, (*smp)[k].type_name()));
+    if (const json* lay = c.object(t, where, "layout")) {
+        c.string_(*lay, where + ": layout", "id_map");
+        if (const json* sp = c.array(*lay, where + ": layout", "spheres"))
+            for (size_t k = 0; k < sp->size(); ++k) {
+                const std::string sw = fmt::format("{}: layout.spheres[{}]", where, k);
+                if (!(*sp)[k].is_object()) c.fail(sw, fmt::format("must be an object, not {}", (*sp)[k].type_name()));
+                c.string_((*sp)[k], sw, "label");
+                c.number((*sp)[k], sw, "roughness");
+                c.number((*sp)[k], sw, "metallic");
+            }
+    }
+    if (const json* o = c.object(t, where, "options"))
+        for (auto& [k, v] : o->items())
+            if (v.is_object() || v.is_array())
+                c.fail(where, fmt::format("options.{} must be a plain value, not {}", k, v.type_name()));
+
+    if (const json* comps = c.array(t, where, "comparisons"))
+        for (size_t ci = 0; ci < comps->size(); ++ci)
+            check_comparison(c, (*comps)[ci], fmt::format("{}: comparisons[{}]", where, ci));
+    check_measurements(c, t, where);
 }
 
 } // namespace
