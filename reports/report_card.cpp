@@ -252,17 +252,9 @@ std::string thumbnail_rel(const json& t) {
     return "";
 }
 
-} // namespace
-
-void test_card(std::string& o, const json& t, size_t idx, PageContext& ctx, const Trend& trend, bool expanded) {
+// The card's facts (scene, environment, method, variant, size, tags) and its stability line.
+void card_meta(std::string& o, const json& t) {
     auto out = std::back_inserter(o);
-    const std::string name = str(t, "name"), v = str(t, "verdict");
-    fmt::format_to(out, "<section class=\"test s-{0} {3}\" id=\"{1}\" data-name=\"{2}\" data-verdict=\"{0}\"{4}>\n", e(v),
-                   test_id(idx), e(name), expanded ? "filterable" : "folded", expanded ? "" : " hidden");
-    const bool flaky = sub(t, "stability").is_object() && sub(t, "stability").value("flaky", false);
-    fmt::format_to(out, "<div class=\"thead\"><span class=\"badge v-{0}\">{0}</span> <h3><a href=\"#{1}\">{2}</a></h3>{3}{4}</div>\n",
-                   e(v), test_id(idx), e(name), flaky ? " <span class=\"badge flaky\">flaky</span>" : "",
-                   expanded ? "" : "<button type=\"button\" class=\"fold\" title=\"fold this card\">fold &#9650;</button>");
     std::vector<std::string> meta;
     for (const char* k : {"scene", "env", "method", "variant"})
         if (!str(t, k).empty()) meta.push_back(fmt::format("{} <b>{}</b>", k, e(str(t, k))));
@@ -284,6 +276,12 @@ void test_card(std::string& o, const json& t, size_t idx, PageContext& ctx, cons
                 line += fmt::format(" &middot; {} {} moves FLIP by {}", e(k), e(value_text(sub(val, "value"))), fmt_num(*f));
         fmt::format_to(out, "<div class=\"meta\">stability: {}</div>\n", line);
     }
+}
+
+// Why the test did not pass: the platform warning, the lines `iblcheck run` prints, and the bless
+// command that approves it.
+void card_why(std::string& o, const json& t, const std::string& v) {
+    auto out = std::back_inserter(o);
     if (!str(t, "driver_mismatch").empty())
         fmt::format_to(out, "<div class=\"warn\">&#9888; {} &mdash; differences may come from the platform (driver or "
                             "the CPU llvmpipe generates code for), not the shader.</div>\n",
@@ -291,11 +289,9 @@ void test_card(std::string& o, const json& t, size_t idx, PageContext& ctx, cons
     // What failed, where, by how much, and the accuracy against the truth before -> after: the
     // lines `iblcheck run` prints (verdict_text.h).
     std::vector<std::string> why = verdict_details(t);
-    std::string bless_line;
-    if (!why.empty() && (why.back().rfind("approve: ", 0) == 0 || why.back().rfind("lock it in: ", 0) == 0)) {
-        bless_line = why.back();
+    // Its last line, the bless command, is shown below as a command to copy.
+    if (!why.empty() && (why.back().rfind("approve: ", 0) == 0 || why.back().rfind("lock it in: ", 0) == 0))
         why.pop_back();
-    }
     if (!why.empty()) {
         o += "<ul class=\"why\">";
         for (const std::string& line : why)
@@ -312,7 +308,11 @@ void test_card(std::string& o, const json& t, size_t idx, PageContext& ctx, cons
                        : v == "improved"     ? "closer to the truth than the golden; accept it:"
                                              : "if the change is intended, approve it:",
                        e(str(t, "bless_command")));
+}
 
+// The image comparisons, one shown at a time, or the rendering alone when nothing was compared.
+void card_images(std::string& o, const json& t, const std::string& name, const std::string& v, PageContext& ctx) {
+    auto out = std::back_inserter(o);
     // Image comparisons, one shown at a time: the first that did not pass, else the baseline.
     std::vector<const json*> cmps;
     if (sub(t, "comparisons").is_array())
@@ -352,19 +352,39 @@ void test_card(std::string& o, const json& t, size_t idx, PageContext& ctx, cons
             if (v == "missing-golden") o += "<div class=\"meta\">no golden to compare with yet</div>";
         }
     }
+}
+
+// The test's history in one line: its verdicts and what moved.
+void card_trend(std::string& o, const Trend& trend) {
+    if (!trend.any) return;
+    std::string moved;
+    if (!trend.flip.moved.empty()) moved += " &middot; <span class=\"moved-txt\">accuracy moved " + e(trend.flip.moved) + "</span>";
+    if (!trend.cost.moved.empty()) moved += " &middot; <span class=\"moved-txt\">cost moved " + e(trend.cost.moved) + "</span>";
+    if (!trend.frame.moved.empty()) moved += " &middot; <span class=\"moved-txt\">frame time moved " + e(trend.frame.moved) + "</span>";
+    fmt::format_to(std::back_inserter(o), "<div class=\"trend\">History: <span class=\"vstrip\">{}</span>{} &middot; <a href=\"#history\">trend</a></div>",
+                   trend.verdict_strip, moved);
+}
+
+} // namespace
+
+void test_card(std::string& o, const json& t, size_t idx, PageContext& ctx, const Trend& trend, bool expanded) {
+    auto out = std::back_inserter(o);
+    const std::string name = str(t, "name"), v = str(t, "verdict");
+    fmt::format_to(out, "<section class=\"test s-{0} {3}\" id=\"{1}\" data-name=\"{2}\" data-verdict=\"{0}\"{4}>\n", e(v),
+                   test_id(idx), e(name), expanded ? "filterable" : "folded", expanded ? "" : " hidden");
+    const bool flaky = sub(t, "stability").is_object() && sub(t, "stability").value("flaky", false);
+    fmt::format_to(out, "<div class=\"thead\"><span class=\"badge v-{0}\">{0}</span> <h3><a href=\"#{1}\">{2}</a></h3>{3}{4}</div>\n",
+                   e(v), test_id(idx), e(name), flaky ? " <span class=\"badge flaky\">flaky</span>" : "",
+                   expanded ? "" : "<button type=\"button\" class=\"fold\" title=\"fold this card\">fold &#9650;</button>");
+    card_meta(o, t);
+    card_why(o, t, v);
+    card_images(o, t, name, v, ctx);
     o += "<div class=\"cols\">";
     cost_html(o, t);
     accuracy_html(o, t);
     o += "</div>";
     temporal_html(o, sub(t, "temporal"), ctx.images);
-    if (trend.any) {
-        std::string moved;
-        if (!trend.flip.moved.empty()) moved += " &middot; <span class=\"moved-txt\">accuracy moved " + e(trend.flip.moved) + "</span>";
-        if (!trend.cost.moved.empty()) moved += " &middot; <span class=\"moved-txt\">cost moved " + e(trend.cost.moved) + "</span>";
-        if (!trend.frame.moved.empty()) moved += " &middot; <span class=\"moved-txt\">frame time moved " + e(trend.frame.moved) + "</span>";
-        fmt::format_to(out, "<div class=\"trend\">History: <span class=\"vstrip\">{}</span>{} &middot; <a href=\"#history\">trend</a></div>",
-                       trend.verdict_strip, moved);
-    }
+    card_trend(o, trend);
     o += "</section>\n";
 }
 
