@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "metrics/display_transform.h"
+#include "metrics/flip_json.h"
 #include "metrics/psnr.h"
 #include "metrics/ssim.h"
 #include "renderers/scenes/scene.h"
@@ -17,11 +18,7 @@ json compare_images(const cv::Mat& golden, const cv::Mat& test, int flip_threads
     FlipResult f = compute_flip_hdr(golden, test, fo);
     PsnrResult p = compute_psnr(display_transform(golden), display_transform(test));
     json j;
-    j["flip"] = {{"mean", f.mean}, {"weighted_median", f.weighted_median}, {"weighted_q1", f.weighted_q1},
-                 {"weighted_q3", f.weighted_q3}, {"p99", f.p99}, {"min", f.min}, {"max", f.max},
-                 {"block_max", f.block_max}, {"block_x", f.block_x}, {"block_y", f.block_y}, {"mode", f.mode},
-                 {"start_exposure", f.start_exposure}, {"stop_exposure", f.stop_exposure},
-                 {"num_exposures", f.num_exposures}, {"exposure_source", f.exposure_source}};
+    j["flip"] = flip_json(f);
     if (ssim_applicable(golden))
         j["ssim"] = {{"mean", compute_ssim_hdr(golden, test).mean}};
     else

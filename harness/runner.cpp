@@ -233,6 +233,19 @@ Comparison judge_against_truth(const TestCase& tc, const cv::Mat& image, const G
     return c;
 }
 
+// The cost checks against the approved baseline (judge_costs), as one comparison of kind "cost".
+Comparison cost_comparison(const TestCase& tc, const RenderResult& rr, const BaselineOutcome& base) {
+    Comparison cost;
+    cost.kind = "cost";
+    cost.golden = base.comparison.golden;
+    cost.checks = judge_costs(tc, rr, base.golden);
+    for (const Check& k : cost.checks) {
+        cost.message += k.message.empty() ? "" : (cost.message.empty() ? "" : "; ") + k.message;
+        cost.verdict = overall_verdict({cost.verdict, k.status});
+    }
+    return cost;
+}
+
 // One test: render, compare, decide. Never throws: every outcome becomes a verdict.
 json run_test(const TestCase& tc, Worker& w, const GoldenStore& store, const fs::path& out_dir, int flip_threads,
               int timing_repeats, bool& shader_error) {
@@ -266,14 +279,7 @@ json run_test(const TestCase& tc, Worker& w, const GoldenStore& store, const fs:
             if (!base.missing) r["comparisons"].back()["approved"] = baseline_facts(base.golden.provenance);
             add(base.comparison.verdict, base.missing ? base.comparison.message : base.comparison.message.empty() ? "" : "baseline: " + base.comparison.message);
             if (!base.missing) {
-                Comparison cost;
-                cost.kind = "cost";
-                cost.golden = base.comparison.golden;
-                cost.checks = judge_costs(tc, rr, base.golden);
-                for (const Check& k : cost.checks) {
-                    cost.message += k.message.empty() ? "" : (cost.message.empty() ? "" : "; ") + k.message;
-                    cost.verdict = overall_verdict({cost.verdict, k.status});
-                }
+                const Comparison cost = cost_comparison(tc, rr, base);
                 r["comparisons"].push_back(to_json(cost));
                 add(cost.verdict, cost.message);
                 std::string diff = platform_difference(base.golden.provenance, rr.provenance, this_cpu_class());
@@ -377,6 +383,23 @@ void print_test_line(const json& r, int n, size_t total, bool interactive) {
     std::fflush(stdout);
 }
 
+// The lines every run prints, -q or not: the fp16 path mediump tests took, the counts, and the
+// command that approves every failure.
+void print_run_summary(const json& R, const RunSummary& s, size_t n_tests, const RunOptions& o, const std::string& suite_arg) {
+    // The fp16 path mediump tests took (doctor states the same rule): native float16_t, or the
+    // emulation on a driver without shaderFloat16 (e.g. a CPU without F16C).
+    std::set<std::string> fp16;
+    for (const json& r : R["tests"])
+        if (r.contains("provenance") && r["provenance"].contains("fp16")) fp16.insert(r["provenance"]["fp16"].get<std::string>());
+    for (const std::string& f : fp16)
+        fmt::print("precision=mediump ran with {} fp16{}\n", f,
+                   f == "emulated" ? " (no shaderFloat16: fp32 rounded to fp16 after every fp16 operation)" : " (float16_t)");
+    fmt::print("{} tests: {} pass, {} fail, {} improved, {} missing-golden, {} error  ({:.1f} s){}\n", n_tests,
+               s.pass, s.fail, s.improved, s.missing, s.error, R["total_s"].get<double>(),
+               o.out_dir.empty() ? "" : "  report: " + (o.out_dir / "index.html").string());
+    if (std::string all = rebless_all_line(R["tests"], suite_arg); !all.empty()) fmt::print("{}\n", all);
+}
+
 } // namespace
 
 int RunSummary::exit_code() const {
@@ -458,20 +481,7 @@ RunSummary run_suite(const RunOptions& o) {
         history = read_history(o.history);
     }
     if (!o.out_dir.empty() && o.report) write_report(R, o.out_dir, o.out_dir, history);
-    {  // -q drops the per-test lines, never this summary
-        // The fp16 path mediump tests took (doctor states the same rule): native float16_t, or the
-        // emulation on a driver without shaderFloat16 (e.g. a CPU without F16C).
-        std::set<std::string> fp16;
-        for (const json& r : R["tests"])
-            if (r.contains("provenance") && r["provenance"].contains("fp16")) fp16.insert(r["provenance"]["fp16"].get<std::string>());
-        for (const std::string& f : fp16)
-            fmt::print("precision=mediump ran with {} fp16{}\n", f,
-                       f == "emulated" ? " (no shaderFloat16: fp32 rounded to fp16 after every fp16 operation)" : " (float16_t)");
-        fmt::print("{} tests: {} pass, {} fail, {} improved, {} missing-golden, {} error  ({:.1f} s){}\n", tests.size(),
-                   s.pass, s.fail, s.improved, s.missing, s.error, R["total_s"].get<double>(),
-                   o.out_dir.empty() ? "" : "  report: " + (o.out_dir / "index.html").string());
-        if (std::string all = rebless_all_line(R["tests"], tests[0].suite_arg); !all.empty()) fmt::print("{}\n", all);
-    }
+    print_run_summary(R, s, tests.size(), o, tests[0].suite_arg); // -q drops the per-test lines, never this summary
     return s;
 }
 

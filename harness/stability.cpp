@@ -61,6 +61,20 @@ json margins_of(const TestCase& tc, const std::map<std::string, double>& floor, 
     }
     return margins;
 }
+// How far the metrics move under a small camera shift and a small roughness change.
+json sensitivity(const TestCase& tc, Worker& w, const cv::Mat& base, int flip_threads) {
+    const StabilitySpec& st = tc.stability;
+    json sens;
+    for (auto [key, value] : {std::pair<std::string, std::string>{"camera_shift", fmt::format("{},{},0", st.camera_shift, st.camera_shift)},
+                              std::pair<std::string, std::string>{"roughness_bias", fmt::format("{}", st.roughness_bias)}}) {
+        TestSpec p = tc.spec;
+        p.options.set(key, value);
+        json m = compare_images(base, w.renderer.render(p).image, flip_threads);
+        sens[key] = {{"value", value}, {"flip.mean", m["flip"]["mean"]}, {"flip.p99", m["flip"]["p99"]},
+                     {"flip.block_max", m["flip"]["block_max"]}, {"ssim.mean", m["ssim"]["mean"]}};
+    }
+    return sens;
+}
 } // namespace
 
 double floor_of(const json& metrics, const std::string& metric) {
@@ -126,16 +140,7 @@ StabilityOutcome run_stability(const TestCase& tc, Worker& w, const cv::Mat& bas
     j["seeds"] = monte_carlo(tc.spec) ? st.seeds : 1;
 
     // 3. Sensitivity: what a quarter-pixel camera shift or a 1e-3 roughness change does.
-    json sens;
-    for (auto [key, value] : {std::pair<std::string, std::string>{"camera_shift", fmt::format("{},{},0", st.camera_shift, st.camera_shift)},
-                              std::pair<std::string, std::string>{"roughness_bias", fmt::format("{}", st.roughness_bias)}}) {
-        TestSpec p = tc.spec;
-        p.options.set(key, value);
-        json m = compare_images(base, w.renderer.render(p).image, flip_threads);
-        sens[key] = {{"value", value}, {"flip.mean", m["flip"]["mean"]}, {"flip.p99", m["flip"]["p99"]},
-                     {"flip.block_max", m["flip"]["block_max"]}, {"ssim.mean", m["ssim"]["mean"]}};
-    }
-    j["sensitivity"] = sens;
+    j["sensitivity"] = sensitivity(tc, w, base, flip_threads);
 
     // 4. Margins against the combined floor; the smallest one names the weakest tolerance.
     json margins = margins_of(tc, floor, approved_accuracy);

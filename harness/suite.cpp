@@ -8,6 +8,7 @@
 #include <set>
 
 #include "harness/common/errors.h"
+#include "harness/common/json_check.h"
 #include "renderers/option_table.h"
 #include "renderers/renderer.h"
 
@@ -20,32 +21,9 @@ namespace {
 
 const std::set<std::string> kMetrics = {"flip.mean", "flip.p99", "flip.block_max", "ssim.mean", "psnr.db"};
 
-struct Ctx {
-    std::string file;
-    [[noreturn]] void fail(const std::string& where, const std::string& problem) const {
-        throw InputError(file + ": " + where + ": " + problem);
-    }
-    void keys(const json& j, const std::string& where, const std::set<std::string>& allowed) const {
-        if (!j.is_object()) fail(where, "must be an object");
-        for (auto& [k, v] : j.items())
-            if (!allowed.count(k)) {
-                std::string list;
-                for (auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-                fail(where + "." + k, "unknown key; valid: " + list);
-            }
-    }
-    std::string str(const json& j, const std::string& where) const {
-        if (!j.is_string()) fail(where, "must be a string");
-        return j.get<std::string>();
-    }
-    double num(const json& j, const std::string& where) const {
-        if (!j.is_number()) fail(where, "must be a number");
-        return j.get<double>();
-    }
-    bool boolean(const json& j, const std::string& where) const {
-        if (!j.is_boolean()) fail(where, "must be true or false");
-        return j.get<bool>();
-    }
+// The suite reader's checks: the shared ones (harness/common/json_check.h) plus options and bounds.
+struct Ctx : JsonChecker {
+    using JsonChecker::JsonChecker;
     // Option values are written as strings or numbers; both become the CLI's text form.
     std::string option_value(const json& j, const std::string& where) const {
         if (j.is_string()) return j.get<std::string>();
@@ -174,6 +152,148 @@ bool glob_match(const std::string& pattern, const std::string& name) {
     }
 }
 
+namespace {
+
+// What the suite's "defaults" give every test.
+struct SuiteDefaults {
+    double max_cost_growth = 0.25;
+    StabilitySpec stability;
+    std::string env = "studio";
+    int width = 0, height = 0;
+    std::map<std::string, Bound> bounds;
+    std::map<std::string, Band> bands;
+};
+
+// "defaults": what every test inherits, plus the suite-wide jobs and timing_repeats.
+SuiteDefaults parse_defaults(const Ctx& c, const json& defaults, Suite& suite) {
+    c.keys(defaults, "defaults", {"env", "size", "jobs", "baseline_tolerances", "reference_band", "stability",
+                                  "max_cost_growth", "timing_repeats"});
+    SuiteDefaults d;
+    if (defaults.contains("max_cost_growth")) d.max_cost_growth = c.num(defaults["max_cost_growth"], "defaults.max_cost_growth");
+    if (defaults.contains("stability")) d.stability = parse_stability(c, defaults["stability"], "defaults.stability", d.stability);
+    if (defaults.contains("env")) d.env = c.str(defaults["env"], "defaults.env");
+    if (defaults.contains("size")) parse_size(c, defaults["size"], "defaults.size", d.width, d.height);
+    if (defaults.contains("jobs")) suite.jobs = int(c.num(defaults["jobs"], "defaults.jobs"));
+    if (defaults.contains("timing_repeats")) {
+        const double n = c.num(defaults["timing_repeats"], "defaults.timing_repeats");
+        if (!(n >= 1 && n <= 20 && n == std::floor(n))) c.fail("defaults.timing_repeats", "must be an integer in 1..20");
+        suite.timing_repeats = int(n);
+    }
+    if (defaults.contains("baseline_tolerances"))
+        d.bounds = c.bounds(defaults["baseline_tolerances"], "defaults.baseline_tolerances");
+    if (defaults.contains("reference_band")) d.bands = c.bands(defaults["reference_band"], "defaults.reference_band");
+    return d;
+}
+
+// A test's "temporal": the frame count, the reference sequence and the checks.
+TemporalSpec parse_temporal(const Ctx& c, const json& tj, const std::string& tw) {
+    TemporalSpec temporal;
+    c.keys(tj, tw, {"frames", "reference_ssaa", "reference_options", "checks"});
+    if (!tj.contains("frames")) c.fail(tw + ".frames", "missing required key");
+    temporal.frames = int(c.num(tj["frames"], tw + ".frames"));
+    if (temporal.frames < 2 || temporal.frames > 256) c.fail(tw + ".frames", "must be in 2..256");
+    if (tj.contains("reference_ssaa")) temporal.reference_ssaa = int(c.num(tj["reference_ssaa"], tw + ".reference_ssaa"));
+    if (tj.contains("reference_options"))
+        temporal.reference_options = c.options(tj["reference_options"], tw + ".reference_options");
+    if (tj.contains("checks")) {
+        const json& cj = tj["checks"];
+        c.keys(cj, tw + ".checks", {"flicker", "variation_ratio", "flip_mean", "flicker_ratio", "flip_ratio"});
+        for (auto& [k, b] : cj.items()) {
+            std::string bw = tw + ".checks." + k;
+            c.keys(b, bw, {"min", "max"});
+            Bound bound;
+            if (b.contains("min")) bound.min = c.num(b["min"], bw + ".min");
+            if (b.contains("max")) bound.max = c.num(b["max"], bw + ".max");
+            temporal.checks[k] = bound;
+        }
+    }
+    return temporal;
+}
+
+// One entry of "tests" before expansion: what its test cases share, its environments, its options
+// and its variants (each test case is one environment × one variant).
+struct TestEntry {
+    TestCase proto;
+    std::vector<std::string> envs;
+    OptionMap base_opts;
+    std::vector<OptionMap> variants;
+};
+
+TestEntry parse_test(const Ctx& c, const json& t, const std::string& w, const Suite& suite, const SuiteDefaults& d) {
+    c.keys(t, w, {"scene", "method", "env", "size", "options", "variants", "baseline", "reference",
+                  "baseline_tolerances", "reference_band", "tags", "temporal", "stability", "max_cost_growth",
+                  "tolerance_note"});
+    if (t.contains("tolerance_note")) c.str(t["tolerance_note"], w + ".tolerance_note");
+    if (!t.contains("scene")) c.fail(w + ".scene", "missing required key");
+    if (!t.contains("method")) c.fail(w + ".method", "missing required key");
+    TestEntry entry;
+    if (!t.contains("env")) entry.envs.push_back(d.env);
+    else if (t["env"].is_array())
+        for (size_t k = 0; k < t["env"].size(); ++k) entry.envs.push_back(c.str(t["env"][k], w + ".env[" + std::to_string(k) + "]"));
+    else entry.envs.push_back(c.str(t["env"], w + ".env"));
+    if (t.contains("options")) entry.base_opts = c.options(t["options"], w + ".options");
+    if (t.contains("variants")) {
+        if (!t["variants"].is_array()) c.fail(w + ".variants", "must be an array of option objects");
+        for (size_t k = 0; k < t["variants"].size(); ++k)
+            entry.variants.push_back(c.options(t["variants"][k], w + ".variants[" + std::to_string(k) + "]"));
+    } else {
+        entry.variants.emplace_back();
+    }
+    TestCase& proto = entry.proto;
+    proto.suite = suite.name;
+    proto.suite_arg = suite.arg;
+    proto.max_cost_growth = t.contains("max_cost_growth") ? c.num(t["max_cost_growth"], w + ".max_cost_growth")
+                                                          : d.max_cost_growth;
+    if (!(proto.max_cost_growth >= 0)) c.fail(w + ".max_cost_growth", "must be >= 0");
+    proto.spec.scene = c.str(t["scene"], w + ".scene");
+    proto.spec.method = c.str(t["method"], w + ".method");
+    proto.spec.width = d.width;
+    proto.spec.height = d.height;
+    if (t.contains("size")) parse_size(c, t["size"], w + ".size", proto.spec.width, proto.spec.height);
+    if (t.contains("baseline")) proto.baseline = c.boolean(t["baseline"], w + ".baseline");
+    if (t.contains("reference")) proto.reference = c.boolean(t["reference"], w + ".reference");
+    proto.baseline_tolerances = d.bounds;
+    if (t.contains("baseline_tolerances"))
+        for (auto& [k, v] : c.bounds(t["baseline_tolerances"], w + ".baseline_tolerances")) {
+            if (v.min || v.max) proto.baseline_tolerances[k] = v;
+            else proto.baseline_tolerances.erase(k);
+        }
+    proto.reference_band = d.bands;
+    if (t.contains("reference_band"))
+        for (auto& [k, v] : c.bands(t["reference_band"], w + ".reference_band")) proto.reference_band[k] = v;
+    if (t.contains("tags"))
+        for (size_t k = 0; k < t["tags"].size(); ++k) proto.tags.push_back(c.str(t["tags"][k], w + ".tags"));
+    proto.stability = t.contains("stability") ? parse_stability(c, t["stability"], w + ".stability", d.stability)
+                                              : d.stability;
+    if (t.contains("temporal")) proto.temporal = parse_temporal(c, t["temporal"], w + ".temporal");
+    return entry;
+}
+
+// The entry's test cases (every environment × every variant), validated and uniquely named.
+void expand_test(const Ctx& c, const TestEntry& entry, const std::string& w, std::set<std::string>& names, Suite& suite) {
+    for (const auto& env : entry.envs)
+        for (const auto& variant : entry.variants) {
+            TestCase tc = entry.proto;
+            tc.spec.env = env;
+            tc.spec.options = entry.base_opts;
+            for (auto& [k, v] : variant.values()) tc.spec.options.set(k, v);
+            // Every option is in the name (not only the variant's), so two suites testing different
+            // configurations never share a name, and so never a baseline golden.
+            tc.variant = tc.spec.options.values().empty() ? "default" : tc.spec.options.canonical();
+            tc.name = tc.spec.method + "." + tc.spec.scene + "." + env + "." + tc.variant;
+            try {
+                validate_spec(tc.spec);
+                if (tc.temporal.frames) validate_spec(temporal_reference_spec(tc));
+            } catch (const UsageError& e) {
+                c.fail(w, e.what());
+            }
+            if (!names.insert(tc.name).second) c.fail(w, "duplicate test name " + tc.name);
+            suite.tests.push_back(std::move(tc));
+        }
+}
+
+} // namespace
+
 Suite load_suite(const std::string& name_or_path) {
     fs::path file = name_or_path;
     if (file.extension() != ".json") file = suite_dir() / (name_or_path + ".json");
@@ -201,126 +321,13 @@ Suite load_suite(const std::string& name_or_path) {
                                                               : name_or_path;
     suite.name = c.str(root["suite"], "suite");
     if (root.contains("description")) suite.description = c.str(root["description"], "description");
-
-    json defaults = root.value("defaults", json::object());
-    c.keys(defaults, "defaults", {"env", "size", "jobs", "baseline_tolerances", "reference_band", "stability",
-                                  "max_cost_growth", "timing_repeats"});
-    double default_cost_growth = defaults.contains("max_cost_growth")
-                                     ? c.num(defaults["max_cost_growth"], "defaults.max_cost_growth")
-                                     : 0.25;
-    StabilitySpec default_stability;
-    if (defaults.contains("stability"))
-        default_stability = parse_stability(c, defaults["stability"], "defaults.stability", default_stability);
-    std::string default_env = defaults.contains("env") ? c.str(defaults["env"], "defaults.env") : "studio";
-    int dw = 0, dh = 0;
-    if (defaults.contains("size")) parse_size(c, defaults["size"], "defaults.size", dw, dh);
-    if (defaults.contains("jobs")) suite.jobs = int(c.num(defaults["jobs"], "defaults.jobs"));
-    if (defaults.contains("timing_repeats")) {
-        const double n = c.num(defaults["timing_repeats"], "defaults.timing_repeats");
-        if (!(n >= 1 && n <= 20 && n == std::floor(n))) c.fail("defaults.timing_repeats", "must be an integer in 1..20");
-        suite.timing_repeats = int(n);
-    }
-    auto default_bounds = defaults.contains("baseline_tolerances")
-                              ? c.bounds(defaults["baseline_tolerances"], "defaults.baseline_tolerances")
-                              : std::map<std::string, Bound>{};
-    auto default_bands = defaults.contains("reference_band")
-                             ? c.bands(defaults["reference_band"], "defaults.reference_band")
-                             : std::map<std::string, Band>{};
+    const SuiteDefaults defaults = parse_defaults(c, root.value("defaults", json::object()), suite);
 
     if (!root["tests"].is_array()) c.fail("tests", "must be an array");
     std::set<std::string> names;
     for (size_t i = 0; i < root["tests"].size(); ++i) {
-        const json& t = root["tests"][i];
-        std::string w = "tests[" + std::to_string(i) + "]";
-        c.keys(t, w, {"scene", "method", "env", "size", "options", "variants", "baseline", "reference",
-                      "baseline_tolerances", "reference_band", "tags", "temporal", "stability", "max_cost_growth",
-                      "tolerance_note"});
-        if (t.contains("tolerance_note")) c.str(t["tolerance_note"], w + ".tolerance_note");
-        if (!t.contains("scene")) c.fail(w + ".scene", "missing required key");
-        if (!t.contains("method")) c.fail(w + ".method", "missing required key");
-        std::vector<std::string> envs;
-        if (!t.contains("env")) envs.push_back(default_env);
-        else if (t["env"].is_array())
-            for (size_t k = 0; k < t["env"].size(); ++k) envs.push_back(c.str(t["env"][k], w + ".env[" + std::to_string(k) + "]"));
-        else envs.push_back(c.str(t["env"], w + ".env"));
-        OptionMap base_opts = t.contains("options") ? c.options(t["options"], w + ".options") : OptionMap{};
-        std::vector<OptionMap> variants;
-        if (t.contains("variants")) {
-            if (!t["variants"].is_array()) c.fail(w + ".variants", "must be an array of option objects");
-            for (size_t k = 0; k < t["variants"].size(); ++k)
-                variants.push_back(c.options(t["variants"][k], w + ".variants[" + std::to_string(k) + "]"));
-        } else {
-            variants.emplace_back();
-        }
-        TestCase proto;
-        proto.suite = suite.name;
-        proto.suite_arg = suite.arg;
-        proto.max_cost_growth = t.contains("max_cost_growth") ? c.num(t["max_cost_growth"], w + ".max_cost_growth")
-                                                              : default_cost_growth;
-        if (!(proto.max_cost_growth >= 0)) c.fail(w + ".max_cost_growth", "must be >= 0");
-        proto.spec.scene = c.str(t["scene"], w + ".scene");
-        proto.spec.method = c.str(t["method"], w + ".method");
-        proto.spec.width = dw;
-        proto.spec.height = dh;
-        if (t.contains("size")) parse_size(c, t["size"], w + ".size", proto.spec.width, proto.spec.height);
-        if (t.contains("baseline")) proto.baseline = c.boolean(t["baseline"], w + ".baseline");
-        if (t.contains("reference")) proto.reference = c.boolean(t["reference"], w + ".reference");
-        proto.baseline_tolerances = default_bounds;
-        if (t.contains("baseline_tolerances"))
-            for (auto& [k, v] : c.bounds(t["baseline_tolerances"], w + ".baseline_tolerances")) {
-                if (v.min || v.max) proto.baseline_tolerances[k] = v;
-                else proto.baseline_tolerances.erase(k);
-            }
-        proto.reference_band = default_bands;
-        if (t.contains("reference_band"))
-            for (auto& [k, v] : c.bands(t["reference_band"], w + ".reference_band")) proto.reference_band[k] = v;
-        if (t.contains("tags"))
-            for (size_t k = 0; k < t["tags"].size(); ++k) proto.tags.push_back(c.str(t["tags"][k], w + ".tags"));
-
-        proto.stability = t.contains("stability") ? parse_stability(c, t["stability"], w + ".stability", default_stability)
-                                                  : default_stability;
-        if (t.contains("temporal")) {
-            const json& tj = t["temporal"];
-            std::string tw = w + ".temporal";
-            c.keys(tj, tw, {"frames", "reference_ssaa", "reference_options", "checks"});
-            if (!tj.contains("frames")) c.fail(tw + ".frames", "missing required key");
-            proto.temporal.frames = int(c.num(tj["frames"], tw + ".frames"));
-            if (proto.temporal.frames < 2 || proto.temporal.frames > 256) c.fail(tw + ".frames", "must be in 2..256");
-            if (tj.contains("reference_ssaa")) proto.temporal.reference_ssaa = int(c.num(tj["reference_ssaa"], tw + ".reference_ssaa"));
-            if (tj.contains("reference_options"))
-                proto.temporal.reference_options = c.options(tj["reference_options"], tw + ".reference_options");
-            if (tj.contains("checks")) {
-                const json& cj = tj["checks"];
-                c.keys(cj, tw + ".checks", {"flicker", "variation_ratio", "flip_mean", "flicker_ratio", "flip_ratio"});
-                for (auto& [k, b] : cj.items()) {
-                    std::string bw = tw + ".checks." + k;
-                    c.keys(b, bw, {"min", "max"});
-                    Bound bound;
-                    if (b.contains("min")) bound.min = c.num(b["min"], bw + ".min");
-                    if (b.contains("max")) bound.max = c.num(b["max"], bw + ".max");
-                    proto.temporal.checks[k] = bound;
-                }
-            }
-        }
-        for (const auto& env : envs)
-            for (const auto& variant : variants) {
-                TestCase tc = proto;
-                tc.spec.env = env;
-                tc.spec.options = base_opts;
-                for (auto& [k, v] : variant.values()) tc.spec.options.set(k, v);
-                // Every option is in the name (not only the variant's), so two suites testing different
-                // configurations never share a name, and so never a baseline golden.
-                tc.variant = tc.spec.options.values().empty() ? "default" : tc.spec.options.canonical();
-                tc.name = tc.spec.method + "." + tc.spec.scene + "." + env + "." + tc.variant;
-                try {
-                    validate_spec(tc.spec);
-                    if (tc.temporal.frames) validate_spec(temporal_reference_spec(tc));
-                } catch (const UsageError& e) {
-                    c.fail(w, e.what());
-                }
-                if (!names.insert(tc.name).second) c.fail(w, "duplicate test name " + tc.name);
-                suite.tests.push_back(std::move(tc));
-            }
+        const std::string w = "tests[" + std::to_string(i) + "]";
+        expand_test(c, parse_test(c, root["tests"][i], w, suite, defaults), w, names, suite);
     }
     if (suite.tests.empty()) c.fail("tests", "the suite has no tests");
     return suite;

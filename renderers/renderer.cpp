@@ -8,6 +8,7 @@
 #include "renderers/mobile/gpu_session.h"
 #include "renderers/mobile/mobile_renderer.h"
 #include "renderers/reference/reference.h"
+#include "renderers/sampled/sampled_renderer.h"
 #include "renderers/scenes/scene.h"
 #include "renderers/vulkan/shader_compiler.h"
 

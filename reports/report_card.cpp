@@ -1,6 +1,5 @@
-// A test's card, its tile in the grid of passing tests, and the image viewer (report_html.h).
-// The viewer's markup works without its script (the PNGs); the script (report_script.h) swaps in
-// canvases drawn from the float data once it has loaded.
+// A test's card and its tile in the grid of passing tests (report_html.h); the image viewer each
+// comparison shows is report_viewer.cpp.
 #include <algorithm>
 #include <cmath>
 #include <iterator>
@@ -14,130 +13,6 @@
 namespace iblcheck::report::html {
 
 namespace {
-
-struct ViewerSpec {
-    std::string test_png, golden_png, heat_png;  // as in results.json
-    std::string test_exr, golden_exr, error_exr;
-    std::string golden_name = "golden";          // "baseline", "reference"
-    std::optional<int> block_x, block_y;
-    std::string block_sphere;
-    double tol = 0.05;
-    std::string tol_note;                        // where the threshold comes from
-};
-
-std::string img_tag(ImageStore& store, const std::string& rel, const char* cls, const std::string& alt) {
-    if (rel.empty()) return "";
-    if (auto u = store.url(rel))
-        return fmt::format("<img class=\"{}\" src=\"{}\" alt=\"{}\">", cls, e(*u), e(alt));
-    return fmt::format("<div class=\"noimg\">missing image:<br><span class=\"mono\">{}</span></div>", e(rel));
-}
-
-// The spheres of the layout, for the id map's data script: {label, roughness, metallic}.
-json spheres_of(const json& t) {
-    const json& sp = sub(sub(t, "layout"), "spheres");
-    json a = json::array();
-    if (sp.is_array())
-        for (const json& s : sp)
-            a.push_back({{"label", str(s, "label")},
-                         {"roughness", std::round(num(s, "roughness").value_or(0) * 1e4) / 1e4},
-                         {"metallic", std::round(num(s, "metallic").value_or(0) * 1e4) / 1e4}});
-    return a;
-}
-
-void viewer_html(std::string& o, PageContext& ctx, const json& t, const ViewerSpec& vs) {
-    auto out = std::back_inserter(o);
-    auto ti = ctx.data.image(vs.test_exr);
-    auto gi = ti ? ctx.data.image(vs.golden_exr) : std::nullopt;
-    auto ei = ti ? ctx.data.image(vs.error_exr) : std::nullopt;
-    const bool live = ti.has_value();
-    auto ids = live ? ctx.data.id_map(str(sub(t, "layout"), "id_map"), spheres_of(t)) : std::nullopt;
-    std::string attrs;
-    if (live) {
-        attrs += fmt::format(" data-test=\"{}\"", ti->key);
-        if (gi && gi->width == ti->width && gi->height == ti->height) attrs += fmt::format(" data-golden=\"{}\"", gi->key);
-        if (ei && ei->width == ti->width && ei->height == ti->height) attrs += fmt::format(" data-error=\"{}\"", ei->key);
-        if (ids) attrs += fmt::format(" data-ids=\"{}\"", *ids);
-    }
-    if (vs.block_x && vs.block_y) attrs += fmt::format(" data-bx=\"{}\" data-by=\"{}\"", *vs.block_x, *vs.block_y);
-    fmt::format_to(out, "<div class=\"viewer\"{} data-tol=\"{}\" data-golden-name=\"{}\">\n", attrs, vs.tol, e(vs.golden_name));
-    const bool has_golden = !vs.golden_png.empty(), has_heat = !vs.heat_png.empty();
-    if (live) {
-        o += "<div class=\"vbar\"><label>exposure <input type=\"range\" class=\"ev\" min=\"-12\" max=\"12\" step=\"0.1\" "
-             "value=\"0\" aria-label=\"exposure in stops\"></label><output class=\"evv\">0.0 EV</output>"
-             "<button type=\"button\" class=\"ev-auto\" title=\"this image's automatic exposure\">auto</button>"
-             "<button type=\"button\" class=\"ev-0\" title=\"the PNG's exposure\">0 EV</button>";
-        if (has_golden)
-            fmt::format_to(out,
-                           "<span><button type=\"button\" class=\"show on\" data-show=\"test\">test</button><button "
-                           "type=\"button\" class=\"show\" data-show=\"golden\">{}</button> <label><input type=\"checkbox\" "
-                           "class=\"blink\"> blink</label></span>",
-                           e(vs.golden_name));
-        o += "<span class=\"zooms\">zoom";
-        for (int z : {1, 2, 3, 4, 6, 8}) fmt::format_to(out, "<button type=\"button\" class=\"z\" data-z=\"{0}\">{0}&times;</button>", z);
-        o += "</span>";
-        if (has_heat)
-            fmt::format_to(out,
-                           "<label>FLIP scale <select class=\"escale\"><option value=\"auto\">auto</option><option "
-                           "value=\"1\">0&ndash;1</option><option value=\"0.5\">0&ndash;0.5</option><option value=\"0.2\">"
-                           "0&ndash;0.2</option><option value=\"0.1\">0&ndash;0.1</option><option value=\"0.05\">0&ndash;"
-                           "0.05</option><option value=\"0.02\">0&ndash;0.02</option><option value=\"0.01\">0&ndash;0.01"
-                           "</option></select></label><label title=\"{}\"><input type=\"checkbox\" class=\"mask\"> mask "
-                           "FLIP &gt; <input type=\"number\" class=\"tol\" min=\"0\" max=\"1\" step=\"0.001\" value=\"{}\">"
-                           "</label>",
-                           e(vs.tol_note), vs.tol);
-        o += "</div>\n";
-    }
-    if (!live) {
-        // No float data (results without EXRs, e.g. from an older harness): the PNGs side by side.
-        o += "<div class=\"vbody\">";
-        fmt::format_to(out, "<figure>{}<figcaption>test</figcaption></figure>", img_tag(ctx.images, vs.test_png, "t", "test"));
-        if (has_golden)
-            fmt::format_to(out, "<figure>{}<figcaption>{}</figcaption></figure>",
-                           img_tag(ctx.images, vs.golden_png, "gold", vs.golden_name), e(vs.golden_name));
-        if (has_heat)
-            fmt::format_to(out, "<figure>{}<figcaption>FLIP per pixel (magma, 0&ndash;1){}</figcaption></figure>",
-                           img_tag(ctx.images, vs.heat_png, "heat", "FLIP heatmap"),
-                           vs.block_x ? fmt::format("; worst 16&times;16 block at ({},{})", *vs.block_x, *vs.block_y) : "");
-        o += "</div></div>\n";
-        return;
-    }
-    o += "<div class=\"vbody\"><div class=\"vmain\">";
-    auto blk = [&] {
-        return vs.block_x ? std::string("<span class=\"blk\" title=\"worst 16x16 block\"></span>") : std::string();
-    };
-    fmt::format_to(out, "<figure class=\"vimg\"><div class=\"stage\">{}{}<canvas class=\"cv-img\" hidden></canvas>{}"
-                        "<span class=\"ptr\" hidden></span></div><figcaption>{}</figcaption></figure>",
-                   img_tag(ctx.images, vs.test_png, "png t", "test"),
-                   has_golden ? img_tag(ctx.images, vs.golden_png, "png g", vs.golden_name) : "", blk(),
-                   has_golden ? "test (buttons: " + e(vs.golden_name) + "); pointer: sphere and values; click: pin the magnifier"
-                              : "test");
-    if (has_heat) {
-        fmt::format_to(out,
-                       "<figure class=\"verr\"><div class=\"stage\">{}<canvas class=\"cv-err\" hidden></canvas>{}"
-                       "<span class=\"ptr\" hidden></span></div>",
-                       img_tag(ctx.images, vs.heat_png, "png heat", "FLIP heatmap"), blk());
-        if (live && ei)
-            o += "<div class=\"cbar\"><canvas></canvas><span class=\"tk\" style=\"left:0\"></span><span class=\"tk\" "
-                 "style=\"left:64px\"></span><span class=\"tk\" style=\"left:128px\"></span><span class=\"tk\" "
-                 "style=\"left:192px\"></span><span class=\"tk\" style=\"left:256px\"></span><span class=\"tol\" "
-                 "title=\"mask threshold\"></span></div>";
-        fmt::format_to(out, "<figcaption>FLIP per pixel vs the {} (magma{}){} <span class=\"maskinfo\"></span></figcaption></figure>", e(vs.golden_name),
-                       live && ei ? ", scale on the bar" : " 0&ndash;1",
-                       vs.block_x ? "; green: the worst 16&times;16 block" : "");
-    }
-    o += "</div>";
-    if (live && vs.block_x)
-        fmt::format_to(out,
-                       "<figure class=\"vmag\"><div class=\"mags\"><div><canvas class=\"mg-t\"></canvas><div class=\"mlbl\">"
-                       "test</div></div>{}{}</div><figcaption class=\"mcap\">worst 16&times;16 block ({},{}){}</figcaption>"
-                       "<button type=\"button\" class=\"worst\">back to the worst block</button></figure>",
-                       has_golden ? "<div><canvas class=\"mg-g\"></canvas><div class=\"mlbl\">" + e(vs.golden_name) + "</div></div>" : "",
-                       has_heat ? "<div><canvas class=\"mg-e\"></canvas><div class=\"mlbl\">FLIP</div></div>" : "", *vs.block_x,
-                       *vs.block_y, vs.block_sphere.empty() ? "" : " on " + e(vs.block_sphere));
-    o += "</div>";
-    if (live) o += "<div class=\"readout mono\">point at an image: pixel, sphere, linear values</div>";
-    o += "</div>\n";
-}
 
 // The exceedance mask's default threshold: the per-pixel tolerance of the comparison (p99: at
 // most 1 % of the pixels may exceed it), else the block tolerance, else the mean's.
@@ -377,17 +252,9 @@ std::string thumbnail_rel(const json& t) {
     return "";
 }
 
-} // namespace
-
-void test_card(std::string& o, const json& t, size_t idx, PageContext& ctx, const Trend& trend, bool expanded) {
+// The card's facts (scene, environment, method, variant, size, tags) and its stability line.
+void card_meta(std::string& o, const json& t) {
     auto out = std::back_inserter(o);
-    const std::string name = str(t, "name"), v = str(t, "verdict");
-    fmt::format_to(out, "<section class=\"test s-{0} {3}\" id=\"{1}\" data-name=\"{2}\" data-verdict=\"{0}\"{4}>\n", e(v),
-                   test_id(idx), e(name), expanded ? "filterable" : "folded", expanded ? "" : " hidden");
-    const bool flaky = sub(t, "stability").is_object() && sub(t, "stability").value("flaky", false);
-    fmt::format_to(out, "<div class=\"thead\"><span class=\"badge v-{0}\">{0}</span> <h3><a href=\"#{1}\">{2}</a></h3>{3}{4}</div>\n",
-                   e(v), test_id(idx), e(name), flaky ? " <span class=\"badge flaky\">flaky</span>" : "",
-                   expanded ? "" : "<button type=\"button\" class=\"fold\" title=\"fold this card\">fold &#9650;</button>");
     std::vector<std::string> meta;
     for (const char* k : {"scene", "env", "method", "variant"})
         if (!str(t, k).empty()) meta.push_back(fmt::format("{} <b>{}</b>", k, e(str(t, k))));
@@ -409,6 +276,12 @@ void test_card(std::string& o, const json& t, size_t idx, PageContext& ctx, cons
                 line += fmt::format(" &middot; {} {} moves FLIP by {}", e(k), e(value_text(sub(val, "value"))), fmt_num(*f));
         fmt::format_to(out, "<div class=\"meta\">stability: {}</div>\n", line);
     }
+}
+
+// Why the test did not pass: the platform warning, the lines `iblcheck run` prints, and the bless
+// command that approves it.
+void card_why(std::string& o, const json& t, const std::string& v) {
+    auto out = std::back_inserter(o);
     if (!str(t, "driver_mismatch").empty())
         fmt::format_to(out, "<div class=\"warn\">&#9888; {} &mdash; differences may come from the platform (driver or "
                             "the CPU llvmpipe generates code for), not the shader.</div>\n",
@@ -416,11 +289,9 @@ void test_card(std::string& o, const json& t, size_t idx, PageContext& ctx, cons
     // What failed, where, by how much, and the accuracy against the truth before -> after: the
     // lines `iblcheck run` prints (verdict_text.h).
     std::vector<std::string> why = verdict_details(t);
-    std::string bless_line;
-    if (!why.empty() && (why.back().rfind("approve: ", 0) == 0 || why.back().rfind("lock it in: ", 0) == 0)) {
-        bless_line = why.back();
+    // Its last line, the bless command, is shown below as a command to copy.
+    if (!why.empty() && (why.back().rfind("approve: ", 0) == 0 || why.back().rfind("lock it in: ", 0) == 0))
         why.pop_back();
-    }
     if (!why.empty()) {
         o += "<ul class=\"why\">";
         for (const std::string& line : why)
@@ -437,7 +308,11 @@ void test_card(std::string& o, const json& t, size_t idx, PageContext& ctx, cons
                        : v == "improved"     ? "closer to the truth than the golden; accept it:"
                                              : "if the change is intended, approve it:",
                        e(str(t, "bless_command")));
+}
 
+// The image comparisons, one shown at a time, or the rendering alone when nothing was compared.
+void card_images(std::string& o, const json& t, const std::string& name, const std::string& v, PageContext& ctx) {
+    auto out = std::back_inserter(o);
     // Image comparisons, one shown at a time: the first that did not pass, else the baseline.
     std::vector<const json*> cmps;
     if (sub(t, "comparisons").is_array())
@@ -477,19 +352,39 @@ void test_card(std::string& o, const json& t, size_t idx, PageContext& ctx, cons
             if (v == "missing-golden") o += "<div class=\"meta\">no golden to compare with yet</div>";
         }
     }
+}
+
+// The test's history in one line: its verdicts and what moved.
+void card_trend(std::string& o, const Trend& trend) {
+    if (!trend.any) return;
+    std::string moved;
+    if (!trend.flip.moved.empty()) moved += " &middot; <span class=\"moved-txt\">accuracy moved " + e(trend.flip.moved) + "</span>";
+    if (!trend.cost.moved.empty()) moved += " &middot; <span class=\"moved-txt\">cost moved " + e(trend.cost.moved) + "</span>";
+    if (!trend.frame.moved.empty()) moved += " &middot; <span class=\"moved-txt\">frame time moved " + e(trend.frame.moved) + "</span>";
+    fmt::format_to(std::back_inserter(o), "<div class=\"trend\">History: <span class=\"vstrip\">{}</span>{} &middot; <a href=\"#history\">trend</a></div>",
+                   trend.verdict_strip, moved);
+}
+
+} // namespace
+
+void test_card(std::string& o, const json& t, size_t idx, PageContext& ctx, const Trend& trend, bool expanded) {
+    auto out = std::back_inserter(o);
+    const std::string name = str(t, "name"), v = str(t, "verdict");
+    fmt::format_to(out, "<section class=\"test s-{0} {3}\" id=\"{1}\" data-name=\"{2}\" data-verdict=\"{0}\"{4}>\n", e(v),
+                   test_id(idx), e(name), expanded ? "filterable" : "folded", expanded ? "" : " hidden");
+    const bool flaky = sub(t, "stability").is_object() && sub(t, "stability").value("flaky", false);
+    fmt::format_to(out, "<div class=\"thead\"><span class=\"badge v-{0}\">{0}</span> <h3><a href=\"#{1}\">{2}</a></h3>{3}{4}</div>\n",
+                   e(v), test_id(idx), e(name), flaky ? " <span class=\"badge flaky\">flaky</span>" : "",
+                   expanded ? "" : "<button type=\"button\" class=\"fold\" title=\"fold this card\">fold &#9650;</button>");
+    card_meta(o, t);
+    card_why(o, t, v);
+    card_images(o, t, name, v, ctx);
     o += "<div class=\"cols\">";
     cost_html(o, t);
     accuracy_html(o, t);
     o += "</div>";
     temporal_html(o, sub(t, "temporal"), ctx.images);
-    if (trend.any) {
-        std::string moved;
-        if (!trend.flip.moved.empty()) moved += " &middot; <span class=\"moved-txt\">accuracy moved " + e(trend.flip.moved) + "</span>";
-        if (!trend.cost.moved.empty()) moved += " &middot; <span class=\"moved-txt\">cost moved " + e(trend.cost.moved) + "</span>";
-        if (!trend.frame.moved.empty()) moved += " &middot; <span class=\"moved-txt\">frame time moved " + e(trend.frame.moved) + "</span>";
-        fmt::format_to(out, "<div class=\"trend\">History: <span class=\"vstrip\">{}</span>{} &middot; <a href=\"#history\">trend</a></div>",
-                       trend.verdict_strip, moved);
-    }
+    card_trend(o, trend);
     o += "</section>\n";
 }
 

@@ -254,11 +254,8 @@ std::string legend_html(Markers& markers, const std::set<std::string>& methods) 
     return o;
 }
 
-} // namespace
-
-std::string charts_html(const std::vector<const json*>& tests, const std::vector<size_t>& order) {
-    std::string o;
-    auto out = std::back_inserter(o);
+// Cost, wall time and texture memory against accuracy: one panel per scene and environment, largest group first.
+void cost_sections(std::string& o, const std::vector<const json*>& tests) {
     // Groups of one scene and environment, largest first.
     std::map<std::string, std::vector<size_t>> groups;
     for (size_t i = 0; i < tests.size(); ++i)
@@ -274,7 +271,7 @@ std::string charts_html(const std::vector<const json*>& tests, const std::vector
         std::vector<size_t> page;
         for (size_t i : idx) {
             gt.push_back(tests[i]);
-            page.push_back(order[i]);
+            page.push_back(i);
             methods.insert(str(*tests[i], "method"));
         }
         cost += cost_panel("cost-accuracy-" + slug(g), g, gt, page, markers);
@@ -307,7 +304,11 @@ std::string charts_html(const std::vector<const json*>& tests, const std::vector
     o += bytes.empty() ? "<p class=\"meta\">No scene and environment has two tests with a texture size and an accuracy "
                          "against the truth.</p>"
                        : "<div class=\"charts\">" + bytes + "</div>\n";
+}
 
+// Error against roughness: per scene and environment, one panel per variant family against the default.
+void roughness_section(std::string& o, const std::vector<const json*>& tests) {
+    auto out = std::back_inserter(o);
     // Error against roughness: per environment, one panel per variant family against the default.
     o += "<h2 id=\"roughness\">Error against roughness</h2>\n<p class=\"meta\">Per sphere, one row per scene and "
          "environment, one panel per thing a variant changes, each against the method's default (grey).</p>\n";
@@ -332,7 +333,7 @@ std::string charts_html(const std::vector<const json*>& tests, const std::vector
             std::vector<size_t> page;
             for (size_t i : idx) {
                 members.push_back(tests[i]);
-                page.push_back(order[i]);
+                page.push_back(i);
             }
             row += roughness_panel("error-roughness-" + slug(g) + "-" + slug(fam), fam, members, page);
         };
@@ -346,7 +347,7 @@ std::string charts_html(const std::vector<const json*>& tests, const std::vector
                 std::vector<size_t> page;
                 for (size_t i : d) {
                     members.push_back(tests[i]);
-                    page.push_back(order[i]);
+                    page.push_back(i);
                 }
                 row += roughness_panel("error-roughness-" + slug(g), g, members, page);
             }
@@ -357,7 +358,10 @@ std::string charts_html(const std::vector<const json*>& tests, const std::vector
         }
     }
     if (!any) o += "<p class=\"meta\">No test has per-sphere errors.</p>\n";
+}
 
+// Flicker against FLIP: one panel per environment, points named by what differs.
+void flicker_section(std::string& o, const std::vector<const json*>& tests) {
     // Flicker against FLIP: one panel per environment, points named by what differs.
     o += "<h2 id=\"temporal\">Flicker against FLIP (temporal tests)</h2>\n";
     std::map<std::string, Chart> flick;
@@ -390,7 +394,7 @@ std::string charts_html(const std::vector<const json*>& tests, const std::vector
         p.y = *fl;
         p.label = test_label(t) + " \u00b7 " + str(t, "env");  // method, variant and environment
         p.tooltip = fmt::format("{}\nFLIP = {}, flicker = {}", str(t, "name"), fmt_num(*fm), fmt_num(*fl));
-        p.href = "#" + test_id(order[i]);
+        p.href = "#" + test_id(i);
         it->points.push_back(std::move(p));
     }
     if (flick.empty()) o += "<p class=\"meta\">No temporal test in this run.</p>\n";
@@ -399,6 +403,15 @@ std::string charts_html(const std::vector<const json*>& tests, const std::vector
         for (auto& [g, c] : flick) o += render_chart(c);
         o += "</div>\n";
     }
+}
+
+} // namespace
+
+std::string charts_html(const std::vector<const json*>& tests) {
+    std::string o;
+    cost_sections(o, tests);
+    roughness_section(o, tests);
+    flicker_section(o, tests);
     return o;
 }
 

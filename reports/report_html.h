@@ -67,6 +67,19 @@ struct PageContext {
     DataStore& data;
 };
 
+// What the image viewer shows: a test image against a golden, with the FLIP heatmap.
+struct ViewerSpec {
+    std::string test_png, golden_png, heat_png;  // as in results.json
+    std::string test_exr, golden_exr, error_exr;
+    std::string golden_name = "golden";          // "baseline", "reference"
+    std::optional<int> block_x, block_y;
+    std::string block_sphere;
+    double tol = 0.05;
+    std::string tol_note;                        // where the threshold comes from
+};
+// The image viewer (report_viewer.cpp): the PNGs, and canvases over the float data for the script.
+void viewer_html(std::string& o, PageContext& ctx, const json& t, const ViewerSpec& vs);
+
 // A test's full card (<section class="test ...">): expanded for what needs a look, folded (hidden,
 // opened from its tile) for a pass.
 void test_card(std::string& o, const json& t, size_t idx, PageContext& ctx, const Trend& trend, bool expanded);
@@ -74,7 +87,7 @@ void test_card(std::string& o, const json& t, size_t idx, PageContext& ctx, cons
 void test_tile(std::string& o, const json& t, size_t idx, PageContext& ctx);
 
 // The charts tab: cost against accuracy, wall time (median and range), error against roughness,
-// flicker against FLIP, each as small multiples. `order[i]` is the page index of tests[i].
-std::string charts_html(const std::vector<const json*>& tests, const std::vector<size_t>& order);
+// flicker against FLIP, each as small multiples. tests[i] is the page's test i (its id test_id(i)).
+std::string charts_html(const std::vector<const json*>& tests);
 
 } // namespace iblcheck::report::html

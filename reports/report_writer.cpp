@@ -191,35 +191,27 @@ std::string js_config() {
                        magma);
 }
 
-} // namespace
+// ---- the page, section by section; each appends its HTML to `o` ----
 
-void write_report(const json& results, const fs::path& results_dir, const fs::path& out_dir,
-                  const std::vector<json>& history) {
-    validate_results(results, (results_dir / "results.json").string());
-    std::error_code ec;
-    fs::create_directories(out_dir, ec);
-    if (!fs::is_directory(out_dir))
-        throw Error(fmt::format("{}: cannot create the report folder: {}", out_dir.string(), ec.message()));
-    ImageStore store(results_dir, out_dir);
-    DataStore data(results_dir, out_dir);
-    PageContext ctx{store, data};
-
-    // Failures first; the original order within a verdict.
+// Failures first; the original order within a verdict.
+std::vector<const json*> page_order(const json& results) {
     std::vector<const json*> tests;
     for (const json& t : results["tests"]) tests.push_back(&t);
     std::stable_sort(tests.begin(), tests.end(), [](const json* a, const json* b) {
         return verdict_rank(str(*a, "verdict")) < verdict_rank(str(*b, "verdict"));
     });
-    std::vector<size_t> order(tests.size());
-    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+    return tests;
+}
 
+std::map<std::string, int> verdict_counts(const std::vector<const json*>& tests) {
     std::map<std::string, int> counts;
     for (auto& v : verdict_order()) counts[v] = 0;
     for (const json* t : tests) counts[str(*t, "verdict")]++;
-    const bool bad = counts["fail"] + counts["error"] + counts["missing-golden"] > 0;
+    return counts;
+}
 
-    // History window: the stored runs plus this one (unless the harness appended it already).
-    const json current = history_entry(results);
+// History window: the stored runs plus this one, `current` (unless the harness appended it already).
+History history_window(const std::vector<json>& history, const json& current) {
     History hist;
     std::vector<const json*> all;
     // Runs of other suites (one history file may serve several) are left out of the trend.
@@ -231,27 +223,49 @@ void write_report(const json& results, const fs::path& results_dir, const fs::pa
         all.push_back(&current);
     const size_t first = all.size() > History::kMaxRuns ? all.size() - History::kMaxRuns : 0;
     hist.runs.assign(all.begin() + long(first), all.end());
-    std::vector<Trend> trends;
-    for (const json* t : tests) trends.push_back(trend_for(hist, str(*t, "name")));
+    return hist;
+}
 
-    std::string o;
-    o.reserve(1 << 18);
-    auto out = std::back_inserter(o);
-    const std::string suite = str(results, "suite");
+void page_head(std::string& o, const std::string& suite, std::map<std::string, int>& counts) {
     std::string title = fmt::format("iblcheck {}: ", suite.empty() ? "report" : suite);
-    {
-        std::string c;
-        for (auto& v : verdict_order())
-            if (counts[v]) c += (c.empty() ? "" : ", ") + fmt::format("{} {}", counts[v], v);
-        title += c.empty() ? "no tests" : c;
-    }
-    fmt::format_to(out,
+    std::string c;
+    for (auto& v : verdict_order())
+        if (counts[v]) c += (c.empty() ? "" : ", ") + fmt::format("{} {}", counts[v], v);
+    title += c.empty() ? "no tests" : c;
+    fmt::format_to(std::back_inserter(o),
                    "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<meta name=\"viewport\" "
                    "content=\"width=device-width, initial-scale=1\">\n<title>{}</title>\n<style>{}</style>\n</head>\n"
                    "<body data-check=\"pending\">\n<main>\n",
                    e(title), assets::kCss);
+}
 
-    // ---- summary ----
+// The run's facts under the summary's heading: commit, start, total time, tests, device, driver.
+void summary_facts(std::string& o, const json& results, size_t n_tests) {
+    std::vector<std::string> facts;
+    std::string commit = "commit <b class=\"mono\">" + e(str(results, "commit")) + "</b>";
+    if (results.value("dirty", false)) commit += " <span class=\"badge dirty\">dirty</span>";
+    if (!str(results, "commit").empty()) facts.push_back(commit);
+    if (!str(results, "started").empty()) facts.push_back("started <b>" + e(str(results, "started")) + "</b>");
+    if (auto ts = num(results, "total_s")) facts.push_back(fmt::format("total <b>{} s</b>", fmt_num(*ts)));
+    facts.push_back(fmt::format("<b>{}</b> tests", n_tests));
+    const json& drv = sub(results, "driver");
+    if (!value_text(sub(drv, "device")).empty()) facts.push_back("device <b>" + e(value_text(sub(drv, "device"))) + "</b>");
+    std::string v;
+    for (auto [k, label] : {std::pair{"mesa", "Mesa"}, {"llvm", "LLVM"}, {"api", "Vulkan"}})
+        if (!value_text(sub(drv, k)).empty()) v += (v.empty() ? "" : " &middot; ") + fmt::format("{} <b>{}</b>", label, e(value_text(sub(drv, k))));
+    if (!v.empty()) facts.push_back(v);
+    if (!str(results, "cpu_class").empty()) facts.push_back("CPU class <b class=\"mono\">" + e(str(results, "cpu_class")) + "</b>");
+    std::string fj;
+    for (auto& f : facts) fj += (fj.empty() ? "" : " &middot; ") + f;
+    fmt::format_to(std::back_inserter(o), "<div class=\"facts\">{}</div>\n", fj);
+}
+
+// The summary: verdict counts (buttons that filter), the run's facts, what changed since the
+// baselines, the command that ran, and the one line that approves every failure.
+void summary_section(std::string& o, const json& results, const std::vector<const json*>& tests,
+                     std::map<std::string, int>& counts, bool bad) {
+    auto out = std::back_inserter(o);
+    const std::string suite = str(results, "suite");
     fmt::format_to(out, "<header class=\"summary{}\"><div class=\"hrow\"><h1>iblcheck &middot; suite {} <span class=\"badge "
                         "v-{}\">{}</span></h1><div class=\"counts\">",
                    bad ? " overall-fail" : "", e(suite.empty() ? "?" : suite), bad ? "fail" : "pass", bad ? "failed" : "passed");
@@ -261,56 +275,65 @@ void write_report(const json& results, const fs::path& results_dir, const fs::pa
                        "title=\"show only {0} (click again: all)\">{2} {0}</button>",
                        v, counts[v] ? "" : " zero", counts[v]);
     o += "</div></div>\n";
-    {
-        std::vector<std::string> facts;
-        std::string commit = "commit <b class=\"mono\">" + e(str(results, "commit")) + "</b>";
-        if (results.value("dirty", false)) commit += " <span class=\"badge dirty\">dirty</span>";
-        if (!str(results, "commit").empty()) facts.push_back(commit);
-        if (!str(results, "started").empty()) facts.push_back("started <b>" + e(str(results, "started")) + "</b>");
-        if (auto ts = num(results, "total_s")) facts.push_back(fmt::format("total <b>{} s</b>", fmt_num(*ts)));
-        facts.push_back(fmt::format("<b>{}</b> tests", tests.size()));
-        const json& drv = sub(results, "driver");
-        if (!value_text(sub(drv, "device")).empty()) facts.push_back("device <b>" + e(value_text(sub(drv, "device"))) + "</b>");
-        std::string v;
-        for (auto [k, label] : {std::pair{"mesa", "Mesa"}, {"llvm", "LLVM"}, {"api", "Vulkan"}})
-            if (!value_text(sub(drv, k)).empty()) v += (v.empty() ? "" : " &middot; ") + fmt::format("{} <b>{}</b>", label, e(value_text(sub(drv, k))));
-        if (!v.empty()) facts.push_back(v);
-        if (!str(results, "cpu_class").empty()) facts.push_back("CPU class <b class=\"mono\">" + e(str(results, "cpu_class")) + "</b>");
-        std::string fj;
-        for (auto& f : facts) fj += (fj.empty() ? "" : " &middot; ") + f;
-        fmt::format_to(out, "<div class=\"facts\">{}</div>\n", fj);
-    }
+    summary_facts(o, results, tests.size());
     o += since_baselines_html(results, tests);
     if (!str(results, "command").empty())
         fmt::format_to(out, "<div class=\"cmd\"><span class=\"lbl\">run</span><pre><code>{}</code></pre><button "
                             "type=\"button\" class=\"copy\">Copy</button></div>\n",
                        e(str(results, "command")));
-    {
-        json arr = json::array();
-        for (const json* t : tests) arr.push_back(*t);
-        const std::string all_line = rebless_all_line(arr, suite_arg(tests));
-        const size_t colon = all_line.find(": iblcheck bless");
-        if (colon != std::string::npos)
-            fmt::format_to(out,
-                           "<div class=\"cmd bless-all\"><span class=\"lbl\">{}</span><pre><code>{}</code></pre><button "
-                           "type=\"button\" class=\"copy\">Copy</button></div>\n",
-                           e(all_line.substr(0, colon)), e(all_line.substr(colon + 2)));
-    }
+    json arr = json::array();
+    for (const json* t : tests) arr.push_back(*t);
+    const std::string all_line = rebless_all_line(arr, suite_arg(tests));
+    const size_t colon = all_line.find(": iblcheck bless");
+    if (colon != std::string::npos)
+        fmt::format_to(out,
+                       "<div class=\"cmd bless-all\"><span class=\"lbl\">{}</span><pre><code>{}</code></pre><button "
+                       "type=\"button\" class=\"copy\">Copy</button></div>\n",
+                       e(all_line.substr(0, colon)), e(all_line.substr(colon + 2)));
     o += "</header>\n";
+}
 
-    // ---- tabs (with the filter) ----
+// The tab bar, with the name filter and the verdict checkboxes.
+void tabs_nav(std::string& o, size_t n_tests) {
+    auto out = std::back_inserter(o);
     fmt::format_to(out,
                    "<nav class=\"tabs\"><a href=\"#tests\" class=\"on\">Tests ({})</a><a href=\"#charts\">Charts</a>"
                    "<a href=\"#history\">History</a><a href=\"#table\">Table</a><span class=\"filter\"><input "
                    "type=\"search\" id=\"filter-text\" placeholder=\"filter: lagarde, sky_sun, storage=\" aria-label=\"filter "
                    "by name\"><span class=\"vfilter\">",
-                   tests.size());
+                   n_tests);
     for (auto& v : verdict_order())
         fmt::format_to(out, "<label title=\"{0}\"><input type=\"checkbox\" value=\"{0}\" checked><span class=\"badge v-{0}\">{1}</span></label>",
                        v, v == "missing-golden" ? "missing" : v);
     o += "</span><span id=\"filter-count\" class=\"meta\"></span></span></nav>\n";
+}
 
-    // ---- Tests: failures expanded, then the grid of passing tests ----
+// Failure modes: tests tagged failure:NAME, grouped, with each method's error.
+void failure_modes(std::string& o, const std::vector<const json*>& tests) {
+    std::map<std::string, std::vector<size_t>> modes;
+    for (size_t i = 0; i < tests.size(); ++i)
+        if (const json& tags = sub(*tests[i], "tags"); tags.is_array())
+            for (const json& tag : tags)
+                if (tag.is_string() && tag.get<std::string>().rfind("failure:", 0) == 0)
+                    modes[tag.get<std::string>().substr(8)].push_back(i);
+    if (modes.empty()) return;
+    o += "<h2 id=\"failure-modes\">Failure modes</h2>\n<table class=\"grid\"><tr><th>failure mode</th><th>test</th>"
+         "<th>FLIP vs the truth</th><th>verdict</th></tr>\n";
+    for (auto& [mode, idx] : modes)
+        for (size_t k = 0; k < idx.size(); ++k) {
+            const json& t = *tests[idx[k]];
+            auto acc = num(sub(t, "accuracy"), "flip_mean");
+            fmt::format_to(std::back_inserter(o),
+                           "<tr>{}<td><a href=\"#{}\">{}</a></td><td class=\"num\">{}</td><td><span class=\"badge v-{}\">{}</span></td></tr>\n",
+                           k == 0 ? fmt::format("<td rowspan=\"{}\"><b>{}</b></td>", idx.size(), e(mode)) : std::string(),
+                           test_id(idx[k]), e(str(t, "name")), acc ? fmt_num(*acc) : std::string(), e(str(t, "verdict")),
+                           e(str(t, "verdict")));
+        }
+    o += "</table>\n";
+}
+
+// Tests: failures expanded, then the grid of passing tests, then the failure modes.
+void tests_tab(std::string& o, const std::vector<const json*>& tests, PageContext& ctx, const std::vector<Trend>& trends) {
     o += "<section class=\"tab\" id=\"tab-tests\">\n";
     size_t n_open = 0;
     for (size_t i = 0; i < tests.size(); ++i)
@@ -319,8 +342,9 @@ void write_report(const json& results, const fs::path& results_dir, const fs::pa
             ++n_open;
         }
     if (n_open < tests.size()) {
-        fmt::format_to(out, "<h2 id=\"passing\">{} passing test{} <span class=\"meta\">click a tile to open it</span></h2>\n"
-                            "<div class=\"tiles\">\n",
+        fmt::format_to(std::back_inserter(o),
+                       "<h2 id=\"passing\">{} passing test{} <span class=\"meta\">click a tile to open it</span></h2>\n"
+                       "<div class=\"tiles\">\n",
                        tests.size() - n_open, tests.size() - n_open == 1 ? "" : "s");
         for (size_t i = 0; i < tests.size(); ++i)
             if (str(*tests[i], "verdict") == "pass") {
@@ -329,33 +353,13 @@ void write_report(const json& results, const fs::path& results_dir, const fs::pa
             }
         o += "</div>\n";
     }
-    // Failure modes: tests tagged failure:NAME, grouped, with each method's error.
-    std::map<std::string, std::vector<size_t>> modes;
-    for (size_t i = 0; i < tests.size(); ++i)
-        if (const json& tags = sub(*tests[i], "tags"); tags.is_array())
-            for (const json& tag : tags)
-                if (tag.is_string() && tag.get<std::string>().rfind("failure:", 0) == 0)
-                    modes[tag.get<std::string>().substr(8)].push_back(i);
-    if (!modes.empty()) {
-        o += "<h2 id=\"failure-modes\">Failure modes</h2>\n<table class=\"grid\"><tr><th>failure mode</th><th>test</th>"
-             "<th>FLIP vs the truth</th><th>verdict</th></tr>\n";
-        for (auto& [mode, idx] : modes)
-            for (size_t k = 0; k < idx.size(); ++k) {
-                const json& t = *tests[idx[k]];
-                auto acc = num(sub(t, "accuracy"), "flip_mean");
-                fmt::format_to(out, "<tr>{}<td><a href=\"#{}\">{}</a></td><td class=\"num\">{}</td><td><span class=\"badge v-{}\">{}</span></td></tr>\n",
-                               k == 0 ? fmt::format("<td rowspan=\"{}\"><b>{}</b></td>", idx.size(), e(mode)) : std::string(),
-                               test_id(idx[k]), e(str(t, "name")), acc ? fmt_num(*acc) : std::string(), e(str(t, "verdict")),
-                               e(str(t, "verdict")));
-            }
-        o += "</table>\n";
-    }
+    failure_modes(o, tests);
     o += "</section>\n";
+}
 
-    // ---- Charts ----
-    o += "<section class=\"tab\" id=\"tab-charts\">\n" + charts_html(tests, order) + "</section>\n";
-
-    // ---- History ----
+void history_tab(std::string& o, const std::vector<const json*>& tests, const History& hist,
+                 const std::vector<Trend>& trends) {
+    auto out = std::back_inserter(o);
     o += "<section class=\"tab\" id=\"tab-history\">\n<h2>History</h2>\n";
     if (hist.runs.size() < 2) {
         o += "<p class=\"meta\">No history: pass <code>--history FILE</code> (JSON lines, one entry per run) to see "
@@ -386,8 +390,10 @@ void write_report(const json& results, const fs::path& results_dir, const fs::pa
         o += "</table>\n";
     }
     o += "</section>\n";
+}
 
-    // ---- Table of all tests ----
+// The table of all tests.
+void table_tab(std::string& o, const std::vector<const json*>& tests) {
     o += "<section class=\"tab\" id=\"tab-table\">\n<h2>All tests</h2>\n<table class=\"grid overview\"><tr><th>verdict</th>"
          "<th>test</th><th>FLIP vs golden</th><th>FLIP vs the truth</th><th>SPIR-V instr/px</th><th>frame ms</th>"
          "<th>precompute ms</th><th>message</th></tr>\n";
@@ -399,7 +405,7 @@ void write_report(const json& results, const fs::path& results_dir, const fs::pa
             for (const json& c : t["comparisons"])
                 if (!golden_flip) golden_flip = num(sub(sub(c, "metrics"), "flip"), "mean");
         auto cellnum = [](std::optional<double> x) { return x ? fmt_num(*x) : std::string(); };
-        fmt::format_to(out,
+        fmt::format_to(std::back_inserter(o),
                        "<tr class=\"filterable\" data-name=\"{2}\" data-verdict=\"{0}\"><td><span class=\"badge v-{0}\">"
                        "{0}</span></td><td><a href=\"#{1}\">{2}</a></td><td class=\"num\">{3}</td><td class=\"num\">{4}"
                        "</td><td class=\"num\">{5}</td><td class=\"num\">{6}</td><td class=\"num\">{7}</td><td "
@@ -410,19 +416,25 @@ void write_report(const json& results, const fs::path& results_dir, const fs::pa
                        cellnum(num(t, "precompute_ms")), e(short_message(str(t, "message"))), e(str(t, "message")));
     }
     o += "</table>\n</section>\n";
+}
 
+// Images the results named but the folder lacks, the footer and the scripts.
+void page_end(std::string& o, const ImageStore& store, const DataStore& data) {
     if (!store.missing().empty()) {
         o += "<h2>Missing images</h2><ul class=\"mono\">";
-        for (auto& m : store.missing()) fmt::format_to(out, "<li>{}</li>", e(m));
+        for (auto& m : store.missing()) fmt::format_to(std::back_inserter(o), "<li>{}</li>", e(m));
         o += "</ul>";
     }
-    fmt::format_to(out,
+    fmt::format_to(std::back_inserter(o),
                    "<footer>Written by <code>iblcheck report</code> from results schema iblcheck-results/1. Rebuild "
                    "it with <code>iblcheck report RESULTS.json --out DIR [--history FILE]</code>. Static and offline: "
                    "open index.html from the file system; image data in data/ ({} files).</footer>\n</main>\n"
                    "<script>{}</script>\n<script>{}</script>\n</body></html>\n",
                    data.files(), js_config(), assets::kJs);
+}
 
+// Written beside and renamed over index.html, so a reader never sees half a page.
+void write_atomically(const fs::path& out_dir, const std::string& o) {
     const fs::path index = out_dir / "index.html";
     const fs::path tmp = out_dir / "index.html.tmp";
     {
@@ -431,8 +443,43 @@ void write_report(const json& results, const fs::path& results_dir, const fs::pa
         f << o;
         if (!f) throw Error(fmt::format("{}: write failed", tmp.string()));
     }
+    std::error_code ec;
     fs::rename(tmp, index, ec);
     if (ec) throw Error(fmt::format("{}: cannot write the report: {}", index.string(), ec.message()));
+}
+
+} // namespace
+
+void write_report(const json& results, const fs::path& results_dir, const fs::path& out_dir,
+                  const std::vector<json>& history) {
+    validate_results(results, (results_dir / "results.json").string());
+    std::error_code ec;
+    fs::create_directories(out_dir, ec);
+    if (!fs::is_directory(out_dir))
+        throw Error(fmt::format("{}: cannot create the report folder: {}", out_dir.string(), ec.message()));
+    ImageStore store(results_dir, out_dir);
+    DataStore data(results_dir, out_dir);
+    PageContext ctx{store, data};
+
+    const std::vector<const json*> tests = page_order(results);
+    std::map<std::string, int> counts = verdict_counts(tests);
+    const bool bad = counts["fail"] + counts["error"] + counts["missing-golden"] > 0;
+    const json current = history_entry(results);
+    const History hist = history_window(history, current);
+    std::vector<Trend> trends;
+    for (const json* t : tests) trends.push_back(trend_for(hist, str(*t, "name")));
+
+    std::string o;
+    o.reserve(1 << 18);
+    page_head(o, str(results, "suite"), counts);
+    summary_section(o, results, tests, counts, bad);
+    tabs_nav(o, tests.size());
+    tests_tab(o, tests, ctx, trends);
+    o += "<section class=\"tab\" id=\"tab-charts\">\n" + charts_html(tests) + "</section>\n";
+    history_tab(o, tests, hist, trends);
+    table_tab(o, tests);
+    page_end(o, store, data);
+    write_atomically(out_dir, o);
 }
 
 } // namespace iblcheck::report

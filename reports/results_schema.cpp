@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "harness/common/errors.h"
+#include "harness/common/json_check.h"
 #include "reports/report_writer.h"
 
 namespace iblcheck::report {
@@ -16,13 +17,10 @@ namespace {
 
 using json = nlohmann::json;
 
-struct Checker {
-    std::string source;
-
-    [[noreturn]] void fail(const std::string& where, const std::string& problem) const {
-        throw InputError(fmt::format("{}: {}{}{}", source, where, where.empty() ? "" : ": ", problem));
-    }
-    const char* type_name(const json& j) const { return j.type_name(); }
+// The results reader's checks: keys of objects, by type (harness/common/json_check.h), and the
+// arrays and maps of one type the results hold.
+struct Checker : JsonChecker {
+    using JsonChecker::JsonChecker;
 
     const json& require(const json& obj, const std::string& where, const char* key) const {
         auto it = obj.find(key);
@@ -30,45 +28,27 @@ struct Checker {
         return *it;
     }
     void string_(const json& obj, const std::string& where, const char* key, bool required = false) const {
-        auto it = obj.find(key);
-        if (it == obj.end() || it->is_null()) {
-            if (required) fail(where, fmt::format("missing key '{}'", key));
-            return;
-        }
-        if (!it->is_string()) fail(where, fmt::format("'{}' must be a string, not {}", key, type_name(*it)));
+        member(obj, where, key, JsonType::string, required);
     }
     void number(const json& obj, const std::string& where, const char* key, bool required = false) const {
-        auto it = obj.find(key);
-        if (it == obj.end() || it->is_null()) {
-            if (required) fail(where, fmt::format("missing key '{}'", key));
-            return;
-        }
-        if (!it->is_number()) fail(where, fmt::format("'{}' must be a number, not {}", key, type_name(*it)));
+        member(obj, where, key, JsonType::number, required);
     }
     void boolean(const json& obj, const std::string& where, const char* key) const {
-        auto it = obj.find(key);
-        if (it == obj.end() || it->is_null()) return;
-        if (!it->is_boolean()) fail(where, fmt::format("'{}' must be true or false, not {}", key, type_name(*it)));
+        member(obj, where, key, JsonType::boolean);
     }
-    // Returns nullptr when absent or null.
+    // Return nullptr when absent or null.
     const json* object(const json& obj, const std::string& where, const char* key) const {
-        auto it = obj.find(key);
-        if (it == obj.end() || it->is_null()) return nullptr;
-        if (!it->is_object()) fail(where, fmt::format("'{}' must be an object, not {}", key, type_name(*it)));
-        return &*it;
+        return member(obj, where, key, JsonType::object);
     }
     const json* array(const json& obj, const std::string& where, const char* key) const {
-        auto it = obj.find(key);
-        if (it == obj.end() || it->is_null()) return nullptr;
-        if (!it->is_array()) fail(where, fmt::format("'{}' must be an array, not {}", key, type_name(*it)));
-        return &*it;
+        return member(obj, where, key, JsonType::array);
     }
     void string_array(const json& obj, const std::string& where, const char* key) const {
         if (const json* a = array(obj, where, key))
             for (size_t i = 0; i < a->size(); ++i)
                 if (!(*a)[i].is_string())
                     fail(where, fmt::format("'{}[{}]' must be a string (an image path), not {}", key, i,
-                                            type_name((*a)[i])));
+                                            (*a)[i].type_name()));
     }
     void number_map(const json& obj, const std::string& where, const char* key) const {
         if (const json* m = object(obj, where, key))
@@ -81,6 +61,85 @@ struct Checker {
 const std::set<std::string>& verdicts() {
     static const std::set<std::string> v{"pass", "fail", "improved", "missing-golden", "error"};
     return v;
+}
+
+// One entry of a test's "comparisons": its kind, metrics, checks, worst block and images.
+void check_comparison(const Checker& c, const json& cmp, const std::string& cw) {
+    if (!cmp.is_object()) c.fail(cw, fmt::format("must be an object, not {}", cmp.type_name()));
+    c.string_(cmp, cw, "kind", true);
+    c.string_(cmp, cw, "golden");
+    c.string_(cmp, cw, "verdict");
+    c.string_(cmp, cw, "message");
+    c.string_(cmp, cw, "label");
+    if (const json* m = c.object(cmp, cw, "metrics"))
+        for (auto& [name, group] : m->items()) {
+            if (!group.is_object() && !group.is_null())
+                c.fail(cw, fmt::format("metrics.{} must be an object, not {}", name, group.type_name()));
+        }
+    if (const json* checks = c.array(cmp, cw, "checks"))
+        for (size_t k = 0; k < checks->size(); ++k) {
+            const json& ck = (*checks)[k];
+            const std::string kw = fmt::format("{}: checks[{}]", cw, k);
+            if (!ck.is_object()) c.fail(kw, fmt::format("must be an object, not {}", ck.type_name()));
+            c.string_(ck, kw, "metric", true);
+            c.number(ck, kw, "value");
+            c.number(ck, kw, "min");
+            c.number(ck, kw, "max");
+            c.number(ck, kw, "approved");
+            c.string_(ck, kw, "status");
+        }
+    if (const json* wb = c.object(cmp, cw, "worst_block")) {
+        for (const char* k : {"x", "y", "flip"}) c.number(*wb, cw + ": worst_block", k);
+        c.string_(*wb, cw + ": worst_block", "sphere");
+    }
+    if (const json* ap = c.object(cmp, cw, "approved"))
+        for (auto& [k, v] : ap->items())
+            if (!v.is_string() && !v.is_null())
+                c.fail(cw, fmt::format("approved.{} must be a string, not {}", k, v.type_name()));
+    if (const json* imgs = c.object(cmp, cw, "images"))
+        for (auto& [k, v] : imgs->items())
+            if (!v.is_string() && !v.is_null())
+                c.fail(cw, fmt::format("images.{} must be a string (an image path), not {}", k, v.type_name()));
+}
+
+// What a test measured: its pass timings, accuracy, per-sphere errors, temporal and stability figures.
+void check_measurements(const Checker& c, const json& t, const std::string& where) {
+    if (const json* tim = c.array(t, where, "timings"))
+        for (size_t k = 0; k < tim->size(); ++k) {
+            const json& p = (*tim)[k];
+            const std::string pw = fmt::format("{}: timings[{}]", where, k);
+            if (!p.is_object()) c.fail(pw, fmt::format("must be an object, not {}", p.type_name()));
+            c.string_(p, pw, "pass", true);
+            c.number(p, pw, "ms", true);
+            c.boolean(p, pw, "gpu");
+            c.boolean(p, pw, "precompute");
+        }
+    if (const json* acc = c.object(t, where, "accuracy")) {
+        c.number(*acc, where + ": accuracy", "flip_mean");
+        c.string_(*acc, where + ": accuracy", "golden");
+    }
+    if (const json* ps = c.array(t, where, "per_sphere"))
+        for (size_t k = 0; k < ps->size(); ++k) {
+            const json& s = (*ps)[k];
+            const std::string sw = fmt::format("{}: per_sphere[{}]", where, k);
+            if (!s.is_object()) c.fail(sw, fmt::format("must be an object, not {}", s.type_name()));
+            c.string_(s, sw, "label");
+            c.number(s, sw, "roughness", true);
+            c.number(s, sw, "metallic");
+            c.number(s, sw, "flip_mean", true);
+        }
+    if (const json* tp = c.object(t, where, "temporal")) {
+        const std::string tw = where + ": temporal";
+        c.string_array(*tp, tw, "frames");
+        c.string_array(*tp, tw, "reference_frames");
+        for (const char* k : {"flicker", "variation_ratio", "flip_mean"}) c.number(*tp, tw, k);
+    }
+    if (const json* st = c.object(t, where, "stability")) {
+        const std::string sw = where + ": stability";
+        c.number_map(*st, sw, "noise_floor");
+        c.number_map(*st, sw, "margins");
+        c.boolean(*st, sw, "flaky");
+    }
 }
 
 void check_test(const Checker& c, const json& t, size_t i) {
@@ -118,83 +177,10 @@ void check_test(const Checker& c, const json& t, size_t i) {
             if (v.is_object() || v.is_array())
                 c.fail(where, fmt::format("options.{} must be a plain value, not {}", k, v.type_name()));
 
-    if (const json* comps = c.array(t, where, "comparisons")) {
-        for (size_t ci = 0; ci < comps->size(); ++ci) {
-            const json& cmp = (*comps)[ci];
-            const std::string cw = fmt::format("{}: comparisons[{}]", where, ci);
-            if (!cmp.is_object()) c.fail(cw, fmt::format("must be an object, not {}", cmp.type_name()));
-            c.string_(cmp, cw, "kind", true);
-            c.string_(cmp, cw, "golden");
-            c.string_(cmp, cw, "verdict");
-            c.string_(cmp, cw, "message");
-            c.string_(cmp, cw, "label");
-            if (const json* m = c.object(cmp, cw, "metrics"))
-                for (auto& [name, group] : m->items()) {
-                    if (!group.is_object() && !group.is_null())
-                        c.fail(cw, fmt::format("metrics.{} must be an object, not {}", name, group.type_name()));
-                }
-            if (const json* checks = c.array(cmp, cw, "checks"))
-                for (size_t k = 0; k < checks->size(); ++k) {
-                    const json& ck = (*checks)[k];
-                    const std::string kw = fmt::format("{}: checks[{}]", cw, k);
-                    if (!ck.is_object()) c.fail(kw, fmt::format("must be an object, not {}", ck.type_name()));
-                    c.string_(ck, kw, "metric", true);
-                    c.number(ck, kw, "value");
-                    c.number(ck, kw, "min");
-                    c.number(ck, kw, "max");
-                    c.number(ck, kw, "approved");
-                    c.string_(ck, kw, "status");
-                }
-            if (const json* wb = c.object(cmp, cw, "worst_block")) {
-                for (const char* k : {"x", "y", "flip"}) c.number(*wb, cw + ": worst_block", k);
-                c.string_(*wb, cw + ": worst_block", "sphere");
-            }
-            if (const json* ap = c.object(cmp, cw, "approved"))
-                for (auto& [k, v] : ap->items())
-                    if (!v.is_string() && !v.is_null())
-                        c.fail(cw, fmt::format("approved.{} must be a string, not {}", k, v.type_name()));
-            if (const json* imgs = c.object(cmp, cw, "images"))
-                for (auto& [k, v] : imgs->items())
-                    if (!v.is_string() && !v.is_null())
-                        c.fail(cw, fmt::format("images.{} must be a string (an image path), not {}", k, v.type_name()));
-        }
-    }
-    if (const json* tim = c.array(t, where, "timings"))
-        for (size_t k = 0; k < tim->size(); ++k) {
-            const json& p = (*tim)[k];
-            const std::string pw = fmt::format("{}: timings[{}]", where, k);
-            if (!p.is_object()) c.fail(pw, fmt::format("must be an object, not {}", p.type_name()));
-            c.string_(p, pw, "pass", true);
-            c.number(p, pw, "ms", true);
-            c.boolean(p, pw, "gpu");
-            c.boolean(p, pw, "precompute");
-        }
-    if (const json* acc = c.object(t, where, "accuracy")) {
-        c.number(*acc, where + ": accuracy", "flip_mean");
-        c.string_(*acc, where + ": accuracy", "golden");
-    }
-    if (const json* ps = c.array(t, where, "per_sphere"))
-        for (size_t k = 0; k < ps->size(); ++k) {
-            const json& s = (*ps)[k];
-            const std::string sw = fmt::format("{}: per_sphere[{}]", where, k);
-            if (!s.is_object()) c.fail(sw, fmt::format("must be an object, not {}", s.type_name()));
-            c.string_(s, sw, "label");
-            c.number(s, sw, "roughness", true);
-            c.number(s, sw, "metallic");
-            c.number(s, sw, "flip_mean", true);
-        }
-    if (const json* tp = c.object(t, where, "temporal")) {
-        const std::string tw = where + ": temporal";
-        c.string_array(*tp, tw, "frames");
-        c.string_array(*tp, tw, "reference_frames");
-        for (const char* k : {"flicker", "variation_ratio", "flip_mean"}) c.number(*tp, tw, k);
-    }
-    if (const json* st = c.object(t, where, "stability")) {
-        const std::string sw = where + ": stability";
-        c.number_map(*st, sw, "noise_floor");
-        c.number_map(*st, sw, "margins");
-        c.boolean(*st, sw, "flaky");
-    }
+    if (const json* comps = c.array(t, where, "comparisons"))
+        for (size_t ci = 0; ci < comps->size(); ++ci)
+            check_comparison(c, (*comps)[ci], fmt::format("{}: comparisons[{}]", where, ci));
+    check_measurements(c, t, where);
 }
 
 } // namespace

@@ -145,17 +145,16 @@ struct Box {
     bool hits(const Box& o) const { return x0 < o.x1 && o.x0 < x1 && y0 < o.y1 && o.y0 < y1; }
 };
 
-} // namespace
+// A point the chart draws, with its series.
+struct PlotPoint {
+    const ChartPoint* p;
+    size_t series;
+};
 
-std::string render_chart(const Chart& c) {
-    // Points that a log axis cannot show (<= 0) or that are not finite are left out and counted.
-    struct P {
-        const ChartPoint* p;
-        size_t series;
-    };
-    std::vector<P> pts;
-    std::vector<double> xs, ys;
-    size_t skipped = 0;
+// The chart's points: those a log axis cannot show (<= 0) or that are not finite are left out and
+// counted in `skipped`; `xs`, `ys` collect the values the axes must span (ranges included).
+std::vector<PlotPoint> plotted_points(const Chart& c, std::vector<double>& xs, std::vector<double>& ys, size_t& skipped) {
+    std::vector<PlotPoint> pts;
     for (size_t si = 0; si < c.series.size(); ++si)
         for (const ChartPoint& p : c.series[si].points) {
             if (!std::isfinite(p.x) || !std::isfinite(p.y) || (c.x.log && p.x <= 0) || (c.y.log && p.y <= 0)) {
@@ -168,14 +167,24 @@ std::string render_chart(const Chart& c) {
             if (p.xlo && std::isfinite(*p.xlo) && (!c.x.log || *p.xlo > 0)) xs.push_back(*p.xlo);
             if (p.xhi && std::isfinite(*p.xhi)) xs.push_back(*p.xhi);
         }
+    return pts;
+}
 
-    // Layout: plot on top, legend below it in rows that wrap (so two charts fit side by side).
-    const double W = c.width, px0 = 64, px1 = W - 18, py0 = c.note.empty() ? 30 : 44, py1 = py0 + c.plot_height;
-    struct LegendItem {
-        std::string name, color;
-        bool dashed, pareto;
-        double x, y;
-    };
+// The plot's frame in SVG units and its two scales.
+struct Plot {
+    double px0, px1, py0, py1;
+    Scale sx, sy;
+};
+
+struct LegendItem {
+    std::string name, color;
+    bool dashed, pareto;
+    double x, y;
+};
+
+// The legend below the plot, in rows that wrap (so two charts fit side by side); `height` receives
+// the chart's height.
+std::vector<LegendItem> layout_legend(const Chart& c, double W, double px0, double py1, double& height) {
     std::vector<LegendItem> legend;
     if (c.legend) {
         for (const ChartSeries& s : c.series)
@@ -190,33 +199,26 @@ std::string render_chart(const Chart& c) {
         it.y = ly;
         lx += w;
     }
-    const double H = legend.empty() ? py1 + 46 : ly + 14;
-    const Scale sx = make_scale(c.x, xs, px0, px1);
-    const Scale sy = make_scale(c.y, ys, py1, py0);
+    height = legend.empty() ? py1 + 46 : ly + 14;
+    return legend;
+}
 
-    std::string o;
+// Frame, grid, ticks, axis labels ("no data" when nothing is plotted).
+void axes_svg(std::string& o, const Chart& c, const Plot& pl, bool empty) {
     auto out = std::back_inserter(o);
-    fmt::format_to(out,
-                   "<svg class=\"chart\" data-chart=\"{}\" data-points=\"{}\" data-series=\"{}\" data-skipped=\"{}\" "
-                   "xmlns=\"http://www.w3.org/2000/svg\" width=\"{}\" height=\"{}\" viewBox=\"0 0 {} {}\" role=\"img\">\n",
-                   html_escape(c.id), pts.size(), c.series.size(), skipped, W, H, W, H);
-    fmt::format_to(out, "<title>{}</title>\n", html_escape(c.title));
-    fmt::format_to(out, "<text class=\"ctitle\" x=\"{}\" y=\"18\">{}</text>\n", px0 - 40, html_escape(c.title));
-    if (!c.note.empty())
-        fmt::format_to(out, "<text class=\"cnote\" x=\"{}\" y=\"33\">{}</text>\n", px0 - 40, html_escape(c.note));
-    // Frame, grid, ticks.
+    const double px0 = pl.px0, px1 = pl.px1, py0 = pl.py0, py1 = pl.py1;
     fmt::format_to(out, "<rect class=\"plot\" x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\"/>\n", px0, py0, px1 - px0,
                    py1 - py0);
-    for (double t : sx.ticks) {
-        const double x = sx(t);
+    for (double t : pl.sx.ticks) {
+        const double x = pl.sx(t);
         fmt::format_to(out,
                        "<line class=\"grid\" x1=\"{0:.1f}\" y1=\"{1}\" x2=\"{0:.1f}\" y2=\"{2}\"/>"
                        "<line class=\"tick\" x1=\"{0:.1f}\" y1=\"{2}\" x2=\"{0:.1f}\" y2=\"{3}\"/>"
                        "<text class=\"tl\" x=\"{0:.1f}\" y=\"{4}\" text-anchor=\"middle\">{5}</text>\n",
                        x, py0, py1, py1 + 5, py1 + 18, fmt_num(t));
     }
-    for (double t : sy.ticks) {
-        const double y = sy(t);
+    for (double t : pl.sy.ticks) {
+        const double y = pl.sy(t);
         fmt::format_to(out,
                        "<line class=\"grid\" x1=\"{1}\" y1=\"{0:.1f}\" x2=\"{2}\" y2=\"{0:.1f}\"/>"
                        "<line class=\"tick\" x1=\"{3}\" y1=\"{0:.1f}\" x2=\"{1}\" y2=\"{0:.1f}\"/>"
@@ -228,37 +230,38 @@ std::string render_chart(const Chart& c) {
     fmt::format_to(out,
                    "<text class=\"al\" transform=\"translate(16 {}) rotate(-90)\" text-anchor=\"middle\">{}{}</text>\n",
                    (py0 + py1) / 2, html_escape(c.y.label), c.y.log ? " (log scale)" : "");
-    if (pts.empty())
+    if (empty)
         fmt::format_to(out, "<text class=\"cnote\" x=\"{}\" y=\"{}\" text-anchor=\"middle\">no data</text>\n",
                        (px0 + px1) / 2, (py0 + py1) / 2);
+}
 
-    // Pareto front: staircase through the non-dominated points (everything above/right is worse).
-    if (c.pareto && !pts.empty()) {
-        std::vector<std::pair<double, double>> xy;
-        for (auto& p : pts) xy.emplace_back(p.p->x, p.p->y);
-        std::vector<size_t> f = pareto_front(xy);
-        std::sort(f.begin(), f.end(), [&](size_t a, size_t b) { return xy[a] < xy[b]; });
-        std::string poly;
-        for (size_t k = 0; k < f.size(); ++k) {
-            const double x = sx(xy[f[k]].first), y = sy(xy[f[k]].second);
-            if (k > 0) poly += fmt::format("{:.1f},{:.1f} ", x, sy(xy[f[k - 1]].second));
-            poly += fmt::format("{:.1f},{:.1f} ", x, y);
-        }
-        if (!f.empty()) {
-            poly += fmt::format("{:.1f},{:.1f}", px1, sy(xy[f.back()].second));
-            std::string members;
-            for (size_t k : f) members += (members.empty() ? "" : "; ") + pts[k].p->label;
-            fmt::format_to(out,
-                           "<polyline class=\"pareto-front\" data-front=\"{}\" points=\"{}\"><title>Pareto front: {}"
-                           "</title></polyline>\n",
-                           f.size(), poly, html_escape(members));
-            for (size_t k : f)
-                fmt::format_to(out, "<circle class=\"front-ring\" cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"7\"/>\n",
-                               sx(xy[k].first), sy(xy[k].second));
-        }
+// Pareto front: staircase through the non-dominated points (everything above/right is worse).
+void pareto_svg(std::string& o, const std::vector<PlotPoint>& pts, const Plot& pl) {
+    std::vector<std::pair<double, double>> xy;
+    for (auto& p : pts) xy.emplace_back(p.p->x, p.p->y);
+    std::vector<size_t> f = pareto_front(xy);
+    std::sort(f.begin(), f.end(), [&](size_t a, size_t b) { return xy[a] < xy[b]; });
+    std::string poly;
+    for (size_t k = 0; k < f.size(); ++k) {
+        const double x = pl.sx(xy[f[k]].first), y = pl.sy(xy[f[k]].second);
+        if (k > 0) poly += fmt::format("{:.1f},{:.1f} ", x, pl.sy(xy[f[k - 1]].second));
+        poly += fmt::format("{:.1f},{:.1f} ", x, y);
     }
+    if (f.empty()) return;
+    poly += fmt::format("{:.1f},{:.1f}", pl.px1, pl.sy(xy[f.back()].second));
+    std::string members;
+    for (size_t k : f) members += (members.empty() ? "" : "; ") + pts[k].p->label;
+    fmt::format_to(std::back_inserter(o),
+                   "<polyline class=\"pareto-front\" data-front=\"{}\" points=\"{}\"><title>Pareto front: {}"
+                   "</title></polyline>\n",
+                   f.size(), poly, html_escape(members));
+    for (size_t k : f)
+        fmt::format_to(std::back_inserter(o), "<circle class=\"front-ring\" cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"7\"/>\n",
+                       pl.sx(xy[k].first), pl.sy(xy[k].second));
+}
 
-    // Lines, then points and labels (labels avoid each other greedily; the tooltip always has it).
+// The lines of the series that connect their points, in x order.
+void series_lines_svg(std::string& o, const Chart& c, const std::vector<PlotPoint>& pts, const Plot& pl) {
     for (size_t si = 0; si < c.series.size(); ++si) {
         const ChartSeries& s = c.series[si];
         if (!s.connect) continue;
@@ -268,23 +271,29 @@ std::string render_chart(const Chart& c) {
         std::sort(xy.begin(), xy.end());
         if (xy.size() < 2) continue;
         std::string poly;
-        for (auto& [x, y] : xy) poly += fmt::format("{:.1f},{:.1f} ", sx(x), sy(y));
-        fmt::format_to(out,
+        for (auto& [x, y] : xy) poly += fmt::format("{:.1f},{:.1f} ", pl.sx(x), pl.sy(y));
+        fmt::format_to(std::back_inserter(o),
                        "<polyline class=\"series{}\" data-series=\"{}\" stroke=\"{}\" points=\"{}\"><title>{}</title>"
                        "</polyline>\n",
                        s.dashed ? " dashed" : "", html_escape(s.name), html_escape(s.color), poly, html_escape(s.name));
     }
+}
+
+// Points with their ranges, tooltips and links, and labels (placed greedily where they overlap no
+// point and no earlier label; the tooltip always has it).
+void points_svg(std::string& o, const Chart& c, const std::vector<PlotPoint>& pts, const Plot& pl) {
+    auto out = std::back_inserter(o);
     std::vector<Box> placed;
     for (auto& p : pts) {
-        const double x = sx(p.p->x), y = sy(p.p->y);
+        const double x = pl.sx(p.p->x), y = pl.sy(p.p->y);
         placed.push_back({x - 5, y - 5, x + 5, y + 5}); // labels keep off every point
     }
     for (auto& p : pts) {
         const ChartSeries& s = c.series[p.series];
-        const double x = sx(p.p->x), y = sy(p.p->y);
+        const double x = pl.sx(p.p->x), y = pl.sy(p.p->y);
         if (p.p->xlo && p.p->xhi && (!c.x.log || *p.p->xlo > 0))
             fmt::format_to(out, "<line class=\"range\" x1=\"{:.1f}\" y1=\"{:.1f}\" x2=\"{:.1f}\" y2=\"{:.1f}\" stroke=\"{}\"/>",
-                           sx(*p.p->xlo), y, sx(*p.p->xhi), y, html_escape(s.color));
+                           pl.sx(*p.p->xlo), y, pl.sx(*p.p->xhi), y, html_escape(s.color));
         std::string circle = marker_svg(s.marker, x, y, 4.5, s.color, "", s.hollow) +
                              fmt::format(" data-series=\"{}\" data-x=\"{}\" data-y=\"{}\" data-label=\"{}\"><title>{}</title>{}",
                                          html_escape(s.name), p.p->x, p.p->y, html_escape(p.p->label),
@@ -297,9 +306,9 @@ std::string render_chart(const Chart& c) {
             const double w = 5.6 * double(p.p->label.size()), h = 11;
             for (double dy : {-6.0, 6.0, -17.0, 17.0, -28.0, 28.0}) {
                 double lx = x + 7, ly = y + dy;
-                if (lx + w > px1 + 15) lx = x - 7 - w; // keep labels inside the plot
+                if (lx + w > pl.px1 + 15) lx = x - 7 - w; // keep labels inside the plot
                 Box b{lx, ly - h + 2, lx + w, ly + 2};
-                if (b.y0 < py0 || b.y1 > py1 || b.x0 < px0 - 2) continue;
+                if (b.y0 < pl.py0 || b.y1 > pl.py1 || b.x0 < pl.px0 - 2) continue;
                 if (std::any_of(placed.begin(), placed.end(), [&](const Box& q) { return q.hits(b); })) continue;
                 placed.push_back(b);
                 fmt::format_to(out, "<text class=\"pl\" x=\"{:.1f}\" y=\"{:.1f}\">{}</text>", lx, ly,
@@ -309,22 +318,52 @@ std::string render_chart(const Chart& c) {
         }
         o += '\n';
     }
+}
 
-    // Legend.
+void legend_svg(std::string& o, const std::vector<LegendItem>& legend) {
     for (const LegendItem& it : legend) {
         if (it.pareto)
-            fmt::format_to(out,
+            fmt::format_to(std::back_inserter(o),
                            "<g class=\"legend\"><line class=\"pareto-front\" x1=\"{0:.1f}\" y1=\"{1:.1f}\" x2=\"{2:.1f}\" "
                            "y2=\"{1:.1f}\"/><text x=\"{3:.1f}\" y=\"{4:.1f}\">{5}</text></g>\n",
                            it.x, it.y, it.x + 26, it.x + 32, it.y + 4, html_escape(it.name));
         else
-            fmt::format_to(out,
+            fmt::format_to(std::back_inserter(o),
                            "<g class=\"legend\"><line class=\"series{0}\" x1=\"{1:.1f}\" y1=\"{2:.1f}\" x2=\"{3:.1f}\" "
                            "y2=\"{2:.1f}\" stroke=\"{4}\"/><circle cx=\"{5:.1f}\" cy=\"{2:.1f}\" r=\"4\" fill=\"{4}\"/>"
                            "<text x=\"{6:.1f}\" y=\"{7:.1f}\">{8}</text></g>\n",
                            it.dashed ? " dashed" : "", it.x, it.y, it.x + 26, html_escape(it.color), it.x + 13,
                            it.x + 32, it.y + 4, html_escape(it.name));
     }
+}
+
+} // namespace
+
+std::string render_chart(const Chart& c) {
+    std::vector<double> xs, ys;
+    size_t skipped = 0;
+    const std::vector<PlotPoint> pts = plotted_points(c, xs, ys, skipped);
+    // Layout: plot on top, legend below it.
+    const double W = c.width, px0 = 64, px1 = W - 18, py0 = c.note.empty() ? 30 : 44, py1 = py0 + c.plot_height;
+    double H = 0;
+    const std::vector<LegendItem> legend = layout_legend(c, W, px0, py1, H);
+    const Plot pl{px0, px1, py0, py1, make_scale(c.x, xs, px0, px1), make_scale(c.y, ys, py1, py0)};
+
+    std::string o;
+    auto out = std::back_inserter(o);
+    fmt::format_to(out,
+                   "<svg class=\"chart\" data-chart=\"{}\" data-points=\"{}\" data-series=\"{}\" data-skipped=\"{}\" "
+                   "xmlns=\"http://www.w3.org/2000/svg\" width=\"{}\" height=\"{}\" viewBox=\"0 0 {} {}\" role=\"img\">\n",
+                   html_escape(c.id), pts.size(), c.series.size(), skipped, W, H, W, H);
+    fmt::format_to(out, "<title>{}</title>\n", html_escape(c.title));
+    fmt::format_to(out, "<text class=\"ctitle\" x=\"{}\" y=\"18\">{}</text>\n", px0 - 40, html_escape(c.title));
+    if (!c.note.empty())
+        fmt::format_to(out, "<text class=\"cnote\" x=\"{}\" y=\"33\">{}</text>\n", px0 - 40, html_escape(c.note));
+    axes_svg(o, c, pl, pts.empty());
+    if (c.pareto && !pts.empty()) pareto_svg(o, pts, pl);
+    series_lines_svg(o, c, pts, pl);
+    points_svg(o, c, pts, pl);
+    legend_svg(o, legend);
     o += "</svg>\n";
     return o;
 }

@@ -69,6 +69,8 @@ TEST(Suite, SchemaErrorsNameFileKeyAndProblem) {
         {R"({"suite": "x", "tests": [{"scene": "sphere", "method": "mobile", "baseline_tolerances": {"flip.mean": {"maximum": 1}}}]})",
          "tests[0].baseline_tolerances.flip.mean.maximum: unknown key"},
         {R"({"suite": "x", "tests": [{"scene": "sphere", "method": "mobile", "size": "big"}]})", "tests[0].size: 'big' is not WxH"},
+        {R"({"suite": "x", "tests": [{"scene": "sphere", "method": "mobile", "size": 64}]})",
+         "tests[0].size: must be a string, not number"},
         {R"({"suite": "x", "tests": [{"scene": "sphere", "method": "mobile"}, {"scene": "sphere", "method": "mobile"}]})",
          "duplicate test name"},
     };

@@ -19,6 +19,7 @@
 #include "harness/common/errors.h"
 #include "metrics/display_transform.h"
 #include "metrics/flip.h"
+#include "metrics/flip_json.h"
 #include "metrics/flip/magma_table.h"
 #include "metrics/image_io.h"
 
@@ -195,6 +196,28 @@ TEST(Flip, BlockMaxFindsTheWorstBlock) {
     EXPECT_DOUBLE_EQ(r.block_max, 0.5);
     EXPECT_EQ(r.max, 1.0);
     EXPECT_NEAR(r.mean, (256 * 0.5 + 1.0) / 2000.0, 1e-12);
+}
+
+// results.json and `iblcheck compare --json` write FLIP through flip_json: the statistics by value,
+// and the exposure keys only for HDR results.
+TEST(Flip, JsonHoldsTheStatisticsAndHdrExposures) {
+    const cv::Mat a = synthetic(64, 48, 7, 0.05f), b = synthetic(64, 48, 8, 0.05f);
+    const FlipResult l = compute_flip_ldr(a, b);
+    const nlohmann::json lj = flip_json(l);
+    EXPECT_EQ(lj.size(), 11u);
+    EXPECT_EQ(lj["mean"].get<double>(), l.mean);
+    EXPECT_EQ(lj["weighted_q3"].get<double>(), l.weighted_q3);
+    EXPECT_EQ(lj["block_x"].get<int>(), l.block_x);
+    EXPECT_EQ(lj["mode"], "ldr");
+    EXPECT_FALSE(lj.contains("start_exposure"));
+    EXPECT_FALSE(lj.contains("errmap"));
+    const FlipResult h = compute_flip_hdr(a * 3.0, b * 3.0);
+    const nlohmann::json hj = flip_json(h);
+    EXPECT_EQ(hj.size(), 15u);
+    EXPECT_EQ(hj["mode"], "hdr");
+    EXPECT_EQ(hj["stop_exposure"].get<double>(), h.stop_exposure);
+    EXPECT_EQ(hj["num_exposures"].get<int>(), h.num_exposures);
+    EXPECT_EQ(hj["exposure_source"], h.exposure_source);
 }
 
 TEST(Flip, MagmaHeatmapMatchesTable) {

@@ -20,6 +20,7 @@
 #include "renderers/mobile/gpu_session.h"
 #include "renderers/mobile/ibl_precompute.h"
 #include "renderers/mobile/mobile_renderer.h"
+#include "renderers/sampled/sampled_renderer.h"
 #include "renderers/renderer.h"
 #include "renderers/scenes/scene.h"
 

@@ -14,6 +14,7 @@
 
 #include "harness/common/errors.h"
 #include "metrics/flip.h"
+#include "metrics/flip_json.h"
 #include "metrics/image_io.h"
 #include "metrics/psnr.h"
 #include "metrics/ssim.h"
@@ -102,25 +103,10 @@ PairResult compare_pair(const CompareArgs& a) {
         fo.threads = a.threads;
         fr = hdr ? compute_flip_hdr(ref.pixels, test.pixels, fo)
                  : compute_flip_ldr(ref.pixels, test.pixels, fo);
-        nlohmann::json f = {{"mean", fr.mean},
-                            {"weighted_median", fr.weighted_median},
-                            {"weighted_q1", fr.weighted_q1},
-                            {"weighted_q3", fr.weighted_q3},
-                            {"p99", fr.p99},
-                            {"min", fr.min},
-                            {"max", fr.max},
-                            {"block_max", fr.block_max},
-                            {"block_x", fr.block_x},
-                            {"block_y", fr.block_y},
-                            {"mode", fr.mode},
-                            {"ppd", fr.ppd}};
-        if (hdr) {
-            f["start_exposure"] = fr.start_exposure;
-            f["stop_exposure"] = fr.stop_exposure;
-            f["num_exposures"] = fr.num_exposures;
-            f["tone_mapper"] = flip::tone_mapper_name(tm);
-            f["exposure_source"] = fr.exposure_source;
-        }
+        // The shared keys (metrics/flip_json.h), plus what only a command-line comparison chooses.
+        nlohmann::json f = flip_json(fr);
+        f["ppd"] = fr.ppd;
+        if (hdr) f["tone_mapper"] = flip::tone_mapper_name(tm);
         j["flip"] = f;
         if (!a.heatmap.empty()) write_png(a.heatmap, magma_heatmap(fr.errmap));
         if (!a.errmap.empty()) write_exr(a.errmap, fr.errmap);

@@ -20,6 +20,48 @@ void parse_size(const std::string& s, int& w, int& h) {
     if (std::sscanf(s.c_str(), "%dx%d", &w, &h) != 2 || w < 1 || h < 1 || w > 8192 || h > 8192)
         throw UsageError("--size '" + s + "' is not WxH (1..8192)");
 }
+
+// Timings per pass, their total, and the cost figures, one per line.
+void print_render_summary(FILE* human, const RenderResult& r) {
+    double total = 0;
+    for (auto& t : r.timings) {
+        fmt::print(human, "{:<20} {:9.3f} ms  {}{}\n", t.name, t.ms, t.gpu ? "gpu" : "cpu", t.precompute ? "  precompute" : "");
+        total += t.ms;
+    }
+    fmt::print(human, "{:<20} {:9.3f} ms\n", "total", total);
+    fmt::print(human, "texture samples/px  {:.2f}\n", r.texture_fetches_per_pixel);
+    // The deterministic cost (issue 14): the same on every run, where the times above are not.
+    if (r.shader_instructions_per_pixel > 0)
+        fmt::print(human, "spirv instr/px      {:.2f}\n", r.shader_instructions_per_pixel);
+    if (r.texture_bytes > 0)
+        fmt::print(human, "env texture         {} texels, {} bytes\n", r.texel_count, r.texture_bytes);
+}
+
+// `render --json`: provenance, cost and timings.
+nlohmann::json render_json(const RenderResult& r) {
+    nlohmann::json j;
+    j["provenance"] = r.provenance;
+    j["texture_fetches_per_pixel"] = r.texture_fetches_per_pixel;
+    j["shader_instructions_per_pixel"] = r.shader_instructions_per_pixel;
+    if (r.texture_bytes > 0) {
+        j["texture_bytes"] = r.texture_bytes;
+        j["texel_count"] = r.texel_count;
+    }
+    for (auto& t : r.timings)
+        j["timings"].push_back({{"pass", t.name}, {"ms", t.ms}, {"gpu", t.gpu}, {"precompute", t.precompute}});
+    return j;
+}
+
+// To stdout for "-", else to the file.
+void write_render_json(const std::string& path, const nlohmann::json& j) {
+    if (path == "-") {
+        fmt::print("{}\n", j.dump(2));
+    } else {
+        std::ofstream f(path);
+        if (!f) throw InputError(path + ": cannot write");
+        f << j.dump(2) << "\n";
+    }
+}
 } // namespace
 
 void register_list_command(CLI::App& app, int& exit_code) {
@@ -71,49 +113,13 @@ void register_render_command(CLI::App& app, int& exit_code) {
         RenderResult r = renderer.render(spec);
         // With --json - the JSON owns stdout; the human-readable lines go to stderr.
         FILE* human = json_out == "-" ? stderr : stdout;
-        double total = 0;
-        for (auto& t : r.timings) {
-            fmt::print(human, "{:<20} {:9.3f} ms  {}{}\n", t.name, t.ms, t.gpu ? "gpu" : "cpu", t.precompute ? "  precompute" : "");
-            total += t.ms;
-        }
-        fmt::print(human, "{:<20} {:9.3f} ms\n", "total", total);
-        fmt::print(human, "texture samples/px  {:.2f}\n", r.texture_fetches_per_pixel);
-        // The deterministic cost (issue 14): the same on every run, where the times above are not.
-        if (r.shader_instructions_per_pixel > 0)
-            fmt::print(human, "spirv instr/px      {:.2f}\n", r.shader_instructions_per_pixel);
-        if (r.texture_bytes > 0)
-            fmt::print(human, "env texture         {} texels, {} bytes\n", r.texel_count, r.texture_bytes);
+        print_render_summary(human, r);
         if (!out.empty()) {
             write_exr(out, r.image);
             write_png(png.string(), display_transform(r.image));
             fmt::print(human, "wrote {} and {}\n", out, png.string());
         }
-        if (!json_out.empty()) {
-            nlohmann::json j;
-            j["provenance"] = r.provenance;
-            j["texture_fetches_per_pixel"] = r.texture_fetches_per_pixel;
-            j["shader_instructions_per_pixel"] = r.shader_instructions_per_pixel;
-            if (r.texture_bytes > 0) {
-                j["texture_bytes"] = r.texture_bytes;
-                j["texel_count"] = r.texel_count;
-            }
-            for (auto& t : r.timings)
-                j["timings"].push_back({{"pass", t.name}, {"ms", t.ms}, {"gpu", t.gpu}, {"precompute", t.precompute}});
-            if (json_out == "-") {
-                fmt::print("{}\n", j.dump(2));
-            } else {
-                std::ofstream f(json_out);
-                if (!f) throw InputError(json_out + ": cannot write");
-                f << j.dump(2) << "\n";
-            }
-        }
-        // Non-finite pixels are the shader's fault: a regression (exit 1), after the files are
-        // written so the pixels can be inspected.
-        if (NonFinite nf = find_non_finite(r.image); nf.count) {
-            fmt::print(stderr, "error: {} {} under {}: the render has {}\n", method, scene, env, nf.describe());
-            exit_code = kExitRegression;
-            return;
-        }
+        if (!json_out.empty()) write_render_json(json_out, render_json(r));
         // Non-finite pixels are the shader's fault: a regression (exit 1), after the files are
         // written so the pixels can be inspected.
         if (NonFinite nf = find_non_finite(r.image); nf.count) {

@@ -14,9 +14,34 @@ void parse_shard(const std::string& s, int& index, int& count) {
     if (std::sscanf(s.c_str(), "%d/%d", &index, &count) != 2)
         throw UsageError("--shard '" + s + "' is not INDEX/COUNT (0-based index)");
 }
-} // namespace
 
-void register_run_commands(CLI::App& app, int& exit_code) {
+// Runs the suite `repeat` - 1 more times (no outputs, quiet) and prints every verdict that differs
+// from `first`'s; a change turns a pass into a regression.
+void repeat_runs(const RunOptions& run, RunSummary& first, int repeat, int& exit_code) {
+    for (int k = 1; k < repeat; ++k) {
+        RunOptions again = run;
+        again.out_dir.clear();
+        again.junit.clear();
+        again.json.clear();
+        again.history.clear();
+        again.quiet = true;
+        RunSummary next = run_suite(again);
+        int changed = 0;
+        for (size_t i = 0; i < first.results["tests"].size(); ++i) {
+            const auto& a = first.results["tests"][i];
+            const auto& b = next.results["tests"][i];
+            if (a["verdict"] != b["verdict"]) {
+                ++changed;
+                fmt::print("verdict changed on run {}: {} {} -> {}\n", k + 1, a["name"].get<std::string>(),
+                           a["verdict"].get<std::string>(), b["verdict"].get<std::string>());
+            }
+        }
+        fmt::print("repeat {}/{}: {} verdict(s) changed\n", k + 1, repeat, changed);
+        if (changed && exit_code == kExitPass) exit_code = kExitRegression;
+    }
+}
+
+void register_run(CLI::App& app, int& exit_code) {
     static RunOptions run;
     static std::string shard, out, junit, json_out, history, goldens;
     auto* r = app.add_subcommand("run", "Run a suite: render, compare with goldens, verdicts, report");
@@ -54,29 +79,11 @@ void register_run_commands(CLI::App& app, int& exit_code) {
         }
         RunSummary first = run_suite(run);
         exit_code = first.exit_code();
-        for (int k = 1; k < repeat; ++k) {
-            RunOptions again = run;
-            again.out_dir.clear();
-            again.junit.clear();
-            again.json.clear();
-            again.history.clear();
-            again.quiet = true;
-            RunSummary next = run_suite(again);
-            int changed = 0;
-            for (size_t i = 0; i < first.results["tests"].size(); ++i) {
-                const auto& a = first.results["tests"][i];
-                const auto& b = next.results["tests"][i];
-                if (a["verdict"] != b["verdict"]) {
-                    ++changed;
-                    fmt::print("verdict changed on run {}: {} {} -> {}\n", k + 1, a["name"].get<std::string>(),
-                               a["verdict"].get<std::string>(), b["verdict"].get<std::string>());
-                }
-            }
-            fmt::print("repeat {}/{}: {} verdict(s) changed\n", k + 1, repeat, changed);
-            if (changed && exit_code == kExitPass) exit_code = kExitRegression;
-        }
+        repeat_runs(run, first, repeat, exit_code);
     });
+}
 
+void register_bless(CLI::App& app, int& exit_code) {
     static BlessOptions bo;
     static std::string bless_goldens, label;
     auto* b = app.add_subcommand("bless", "Re-render and write baseline goldens (the only writer of goldens)");
@@ -93,7 +100,10 @@ void register_run_commands(CLI::App& app, int& exit_code) {
         if (label_opt->count() > 0) bo.label = label;  // given, even empty: check_label refuses ""
         exit_code = bless(bo);
     });
+}
 
+// The `git bisect run` contract: 0 good, 1 bad, 125 cannot test.
+void register_bisect(CLI::App& app, int& exit_code) {
     static RunOptions bis;
     static std::string bis_goldens;
     auto* s = app.add_subcommand("bisect",
@@ -122,6 +132,14 @@ void register_run_commands(CLI::App& app, int& exit_code) {
         else exit_code = (sum.fail || sum.missing) ? 1 : 0;
         fmt::print("bisect verdict: {}\n", exit_code == 0 ? "good" : exit_code == 1 ? "bad" : "skip (125)");
     });
+}
+
+} // namespace
+
+void register_run_commands(CLI::App& app, int& exit_code) {
+    register_run(app, exit_code);
+    register_bless(app, exit_code);
+    register_bisect(app, exit_code);
 }
 
 namespace {

@@ -9,12 +9,9 @@
 #include <vector>
 
 #include "errors.h"
+#include "vec3.h"
 
 namespace iblcheck {
-
-struct Vec3f {
-    float x = 0, y = 0, z = 0;
-};
 
 class OptionMap {
   public:

@@ -79,42 +79,4 @@ inline void radix_sort_nonnegative(std::vector<float>& v) {
     std::memcpy(v.data(), a.data(), n * sizeof(float));
 }
 
-// The tool's 100-bucket histogram (what its weighted-histogram plot shows; kept for reports) over [0,1]: bucket = size_t(double(v) / 0.01f), v == 1 goes to
-// the last bucket, values outside [0,1] are not counted.
-struct WeightedHistogram {
-    static constexpr size_t kBuckets = 100;
-    std::vector<size_t> counts = std::vector<size_t>(kBuckets, 0);
-
-    void add(float v) {
-        const float bucket_size = 1.0f / float(kBuckets);
-        if (v < 0.0f || v > 1.0f) return;
-        size_t id = size_t(double(v) / bucket_size);
-        if (id == kBuckets) --id;
-        ++counts[id];
-    }
-    void merge(const WeightedHistogram& o) {
-        for (size_t i = 0; i < kBuckets; ++i) counts[i] += o.counts[i];
-    }
-
-    // Percentile of the error-weighted distribution: bucket i has weight count * (i + 0.5) * step;
-    // find the bucket where the running weight crosses `fraction` of the total and interpolate
-    // linearly inside it.
-    double weighted_percentile(double fraction) const {
-        const double step = double(1.0f / float(kBuckets));
-        double total = 0.0;
-        for (size_t i = 0; i < kBuckets; ++i) total += double(counts[i]) * ((double(i) + 0.5) * step);
-        double sum = 0.0;
-        size_t idx = 0;
-        for (size_t i = 0; i < kBuckets; ++i) {
-            const double w = double(counts[i]) * ((double(i) + 0.5) * step);
-            idx = i;
-            if (sum + w > fraction * total) break;
-            sum += w;
-        }
-        const double w = double(counts[idx]) * ((double(idx) + 0.5) * step);
-        if (w == 0.0) return double(idx) * step; // all-zero error map
-        return (double(idx) + (fraction * total - sum) / w) * step;
-    }
-};
-
 } // namespace iblcheck::flip

@@ -1,6 +1,7 @@
 // Environments shared by all methods: a linear-HDR equirectangular image.
 //
-// Direction convention (GLSL mirror: renderers/shaders/equirect.glsl). World is Y-up.
+// Direction convention (GLSL mirror: direction_to_equirect_uv in renderers/shaders/common.glsl and its
+// inverse equirect_decode in env_layout.glsl). World is Y-up.
 //   u = 0.5 + atan2(d.x, −d.z) / 2π,   v = acos(d.y) / π        (u, v in [0,1], v = 0 is straight up)
 //   pixel centre (i + 0.5, j + 0.5) ↔ (u·W, v·H); bilinear, wrapping in u, clamped in v.
 //   inverse: φ = (u − 0.5)·2π, θ = v·π, d = (sin θ sin φ, cos θ, −sin θ cos φ)

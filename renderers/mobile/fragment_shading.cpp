@@ -2,8 +2,8 @@
 
 #include <cstring>
 
-#include "descriptor_types.h"
 #include "harness/common/errors.h"
+#include "renderers/mobile/descriptor_types.h"
 #include "renderers/vulkan/spirv_cost.h"
 
 namespace iblcheck {

@@ -12,7 +12,7 @@
 
 #include "gpu_session.h"
 #include "renderers/render_api.h"
-#include "shade_push.h"
+#include "push_constants.h"
 
 namespace iblcheck {
 

@@ -5,15 +5,15 @@
 #include <cstring>
 
 #include "astc_storage.h"
-#include "descriptor_types.h"
 #include "env_layout.h"
 #include "harness/common/errors.h"
+#include "renderers/mobile/descriptor_types.h"
+#include "renderers/mobile/push_constants.h"
 #include "renderers/option_table.h"
 
 namespace iblcheck {
 
 namespace {
-
 
 uint32_t groups(uint32_t n, uint32_t local = 8) { return (n + local - 1) / local; }
 
@@ -135,10 +135,10 @@ IblResources run_precompute(GpuSession& gpu, const Environment& env, const Preco
                        ? ctx.create_image(VK_FORMAT_R32G32B32A32_SFLOAT, s.irradiance_size, s.irradiance_size, 1, true)
                        : ctx.create_image(VK_FORMAT_R32G32B32A32_SFLOAT, 1, 1, 1, true);
 
-    const auto& p_e2c = gpu.pipeline("equirect_to_cube.comp", {}, {kSampled, kStorageImage}, 12);
-    const auto& p_down = gpu.pipeline("downsample_cube.comp", {}, {kStorageImage, kStorageImage}, 4);
-    const auto& p_pre = gpu.pipeline("prefilter_ggx.comp", storage_defines(s, r.native_r11g11b10), {kSampled, kStorageImage}, 28);
-    const auto& p_sh = gpu.pipeline("sh9_project.comp", {}, {kStorageImage, kStorageBuffer}, 4);
+    const auto& p_e2c = gpu.pipeline("equirect_to_cube.comp", {}, {kSampled, kStorageImage}, sizeof(EquirectToCubePush));
+    const auto& p_down = gpu.pipeline("downsample_cube.comp", {}, {kStorageImage, kStorageImage}, sizeof(DownsamplePush));
+    const auto& p_pre = gpu.pipeline("prefilter_ggx.comp", storage_defines(s, r.native_r11g11b10), {kSampled, kStorageImage}, sizeof(PrefilterPush));
+    const auto& p_sh = gpu.pipeline("sh9_project.comp", {}, {kStorageImage, kStorageBuffer}, sizeof(Sh9Push));
 
     vk::GpuTimer timer(ctx, 8);
     ctx.submit([&](VkCommandBuffer cmd) {
@@ -150,7 +150,7 @@ IblResources run_precompute(GpuSession& gpu, const Environment& env, const Preco
             ctx.transition(cmd, *img, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL);
 
         // 1. equirect → cube, supersampled so each cube texel averages the equirect pixels it covers.
-        struct { uint32_t size, ss; float rot; } pe{s.cube_size, std::max(1u, (ew + 4 * s.cube_size - 1) / (4 * s.cube_size)),
+        EquirectToCubePush pe{s.cube_size, std::max(1u, (ew + 4 * s.cube_size - 1) / (4 * s.cube_size)),
                                                     s.env_rotation_deg};
         std::vector<vk::Binding> be = {vk::Binding::sampled_image(0, equirect.sampled_view, ctx.equirect_sampler()),
                                        vk::Binding::storage_image(1, r.source_cube.storage_views[0])};
@@ -161,16 +161,16 @@ IblResources run_precompute(GpuSession& gpu, const Environment& env, const Preco
         ctx.barrier(cmd);
 
         if (r.full_mips > 1) {
-            uint32_t size1 = std::max(1u, s.cube_size >> 1);
+            const DownsamplePush size1{std::max(1u, s.cube_size >> 1)};
             p_down.warm_up(cmd, {vk::Binding::storage_image(0, r.source_cube.storage_views[0]),
-                                 vk::Binding::storage_image(1, r.source_cube.storage_views[1])}, &size1, 4);
+                                 vk::Binding::storage_image(1, r.source_cube.storage_views[1])}, &size1, sizeof size1);
         }
         timer.begin(cmd, "downsample_cube");
         for (uint32_t m = 1; m < r.full_mips; ++m) {
-            uint32_t size = std::max(1u, s.cube_size >> m);
+            const DownsamplePush size{std::max(1u, s.cube_size >> m)};
             p_down.dispatch(cmd, {vk::Binding::storage_image(0, r.source_cube.storage_views[m - 1]),
                                   vk::Binding::storage_image(1, r.source_cube.storage_views[m])},
-                            &size, 4, groups(size), groups(size), 6);
+                            &size, sizeof size, groups(size.dst_size), groups(size.dst_size), 6);
             ctx.barrier(cmd);
         }
         timer.end(cmd);
@@ -178,7 +178,7 @@ IblResources run_precompute(GpuSession& gpu, const Environment& env, const Preco
         if (s.prefiltered) {
             for (uint32_t m = 0; m < mips; ++m) {
                 if (m == 0) {  // warm-up: a mip-0 copy of one workgroup, overwritten below
-                    struct { uint32_t mip, dst_size, src_size, samples; float full_mips, max_lod, src_max_lod; } pw{
+                    PrefilterPush pw{
                         0, s.cube_size, s.cube_size, s.prefilter_samples, float(r.full_mips), float(mips - 1),
                         float(r.full_mips - 1)};
                     p_pre.warm_up(cmd, {vk::Binding::sampled_image(0, r.source_cube.sampled_view, ctx.linear_sampler()),
@@ -187,7 +187,7 @@ IblResources run_precompute(GpuSession& gpu, const Environment& env, const Preco
                 }
                 // dst_size: the cube's face size, or a 2D layout level's width (its height follows).
                 const uint32_t w = std::max(1u, extent.width >> m), h = std::max(1u, extent.height >> m);
-                struct { uint32_t mip, dst_size, src_size, samples; float full_mips, max_lod, src_max_lod; } pp{
+                PrefilterPush pp{
                     m, w, s.cube_size, s.prefilter_samples, float(r.full_mips),
                     float(mips - 1), float(r.full_mips - 1)};
                 p_pre.dispatch(cmd, {vk::Binding::sampled_image(0, r.source_cube.sampled_view, ctx.linear_sampler()),
@@ -200,32 +200,32 @@ IblResources run_precompute(GpuSession& gpu, const Environment& env, const Preco
 
         // SH9 from a 32² level (or the base if smaller): enough for 9 coefficients, and exact weights.
         uint32_t sh_mip = s.cube_size > 32 ? uint32_t(std::log2(double(s.cube_size / 32))) : 0;
-        uint32_t sh_size = s.cube_size >> sh_mip;
+        const Sh9Push sh_size{s.cube_size >> sh_mip};
         std::vector<vk::Binding> bsh = {vk::Binding::storage_image(0, r.source_cube.storage_views[sh_mip]),
                                         vk::Binding::storage_buffer(1, r.sh)};
-        p_sh.warm_up(cmd, bsh, &sh_size, 4);
+        p_sh.warm_up(cmd, bsh, &sh_size, sizeof sh_size);
         timer.begin(cmd, "sh9_project");
-        p_sh.dispatch(cmd, bsh, &sh_size, 4, 1);
+        p_sh.dispatch(cmd, bsh, &sh_size, sizeof sh_size, 1);
         timer.end(cmd);
 
         if (s.lut) {
-            const auto& p_lut = gpu.pipeline("dfg_lut.comp", {}, {kStorageImage}, 8);
-            uint32_t pl[2] = {s.lut_size, s.lut_samples};
-            p_lut.warm_up(cmd, {vk::Binding::storage_image(0, r.lut.storage_views[0])}, pl, 8);
+            const auto& p_lut = gpu.pipeline("dfg_lut.comp", {}, {kStorageImage}, sizeof(DfgLutPush));
+            const DfgLutPush pl{s.lut_size, s.lut_samples};
+            p_lut.warm_up(cmd, {vk::Binding::storage_image(0, r.lut.storage_views[0])}, &pl, sizeof pl);
             timer.begin(cmd, "dfg_lut");
-            p_lut.dispatch(cmd, {vk::Binding::storage_image(0, r.lut.storage_views[0])}, pl, 8, groups(s.lut_size),
+            p_lut.dispatch(cmd, {vk::Binding::storage_image(0, r.lut.storage_views[0])}, &pl, sizeof pl, groups(s.lut_size),
                            groups(s.lut_size), 1);
             timer.end(cmd);
         }
         if (s.irradiance_cube) {
-            const auto& p_irr = gpu.pipeline("irradiance_cube.comp", {}, {kStorageImage, kStorageImage}, 8);
+            const auto& p_irr = gpu.pipeline("irradiance_cube.comp", {}, {kStorageImage, kStorageImage}, sizeof(IrradiancePush));
             uint32_t src_mip = s.cube_size > 16 ? uint32_t(std::log2(double(s.cube_size / 16))) : 0;
-            uint32_t pi[2] = {s.irradiance_size, s.cube_size >> src_mip};
+            const IrradiancePush pi{s.irradiance_size, s.cube_size >> src_mip};
             std::vector<vk::Binding> bi = {vk::Binding::storage_image(0, r.source_cube.storage_views[src_mip]),
                                            vk::Binding::storage_image(1, r.irradiance.storage_views[0])};
-            p_irr.warm_up(cmd, bi, pi, 8);
+            p_irr.warm_up(cmd, bi, &pi, sizeof pi);
             timer.begin(cmd, "irradiance_cube");
-            p_irr.dispatch(cmd, bi, pi, 8, groups(s.irradiance_size), groups(s.irradiance_size), 6);
+            p_irr.dispatch(cmd, bi, &pi, sizeof pi, groups(s.irradiance_size), groups(s.irradiance_size), 6);
             timer.end(cmd);
         }
         ctx.barrier(cmd);

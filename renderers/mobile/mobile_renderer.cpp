@@ -3,9 +3,9 @@
 #include <chrono>
 #include <optional>
 
-#include "descriptor_types.h"
 #include "gpu_scene.h"
 #include "harness/common/errors.h"
+#include "renderers/mobile/descriptor_types.h"
 #include "renderers/option_table.h"
 #include "ibl_precompute.h"
 #include "renderers/scenes/scene.h"
@@ -94,7 +94,7 @@ RenderResult render_mobile(GpuSession& gpu, const Environment& env, const TestSp
         instructions = f.instructions_per_pixel;
     } else {
         const std::vector<VkDescriptorType> types = {kStorageBuffer, kSampled, kStorageBuffer, kSampled, kSampled, kStorageBuffer};
-        const auto& shade = gpu.pipeline("shade_spheres.comp", defs, types, 48, shade_options);
+        const auto& shade = gpu.pipeline("shade_spheres.comp", defs, types, sizeof(ShadePush), shade_options);
         vk::Buffer out = ctx.create_buffer(VkDeviceSize(width) * height * 16);
         b.push_back(vk::Binding::storage_buffer(5, out));
         vk::GpuTimer timer(ctx, 1);

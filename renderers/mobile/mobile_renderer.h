@@ -6,6 +6,4 @@
 
 namespace iblcheck {
 RenderResult render_mobile(GpuSession& gpu, const Environment& env, const TestSpec& spec);
-// The importance-sampled peer (Substance Painter's approach, third seed): renderers/sampled/.
-RenderResult render_sampled(GpuSession& gpu, const Environment& env, const TestSpec& spec);
 }

@@ -1,9 +1,11 @@
 // `--method sampled`: see shaders/shade_sampled.comp for the estimator. It shares the source
 // pyramid and SH9 passes with the mobile pipeline and skips the prefiltered chain.
+#include "sampled_renderer.h"
+
 #include "harness/common/errors.h"
 #include "renderers/mobile/gpu_scene.h"
 #include "renderers/mobile/ibl_precompute.h"
-#include "renderers/mobile/mobile_renderer.h"
+#include "renderers/mobile/push_constants.h"
 #include "renderers/mobile/shading_cost.h"
 
 namespace iblcheck {
@@ -27,14 +29,11 @@ RenderResult render_sampled(GpuSession& gpu, const Environment& env, const TestS
     const std::vector<VkDescriptorType> types = {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
                                                  VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
                                                  VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
-    const auto& shade = gpu.pipeline("shade_sampled.comp", {}, types, 36);
+    const auto& shade = gpu.pipeline("shade_sampled.comp", {}, types, sizeof(SampledPush));
     vk::Context& ctx = gpu.ctx();
     vk::Buffer scene_buf = upload_scene(ctx, scene);
     vk::Buffer out = ctx.create_buffer(VkDeviceSize(width) * height * 16);
-    struct {
-        uint32_t width, height, ssaa, samples, source_size, seed;
-        float source_max_lod, min_lod, diffuse_roughness;
-    } pc{uint32_t(width), uint32_t(height), uint32_t(o.get_int("ssaa", 2)), uint32_t(samples), ps.cube_size,
+    SampledPush pc{uint32_t(width), uint32_t(height), uint32_t(o.get_int("ssaa", 2)), uint32_t(samples), ps.cube_size,
          uint32_t(o.get_int("seed", 0)), float(ibl.full_mips - 1), float(o.get_double("min_lod", 0.0)),
          float(o.get_double("diffuse_roughness", 0.9))};
     if (pc.ssaa < 1 || pc.ssaa > 16) throw UsageError("option 'ssaa' must be in 1..16");

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "harness/common/options.h"
+#include "harness/common/vec3.h"
 
 namespace iblcheck {
 

@@ -4,7 +4,6 @@
 #include <regex>
 
 #include "harness/common/errors.h"
-#include "spirv_cost.h"
 #include "vk_struct.h"
 
 namespace iblcheck::vk {
@@ -114,6 +113,126 @@ std::string describe(const DeviceEntry& e) {
     return std::string(e.props.deviceName) + " [driver " + e.driver.driverName + "]";
 }
 
+VkDebugUtilsMessengerEXT create_messenger(VkInstance instance, Context* ctx) {
+    auto mi = vk_struct<VkDebugUtilsMessengerCreateInfoEXT>(VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT);
+    mi.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT;
+    mi.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+                     VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
+    mi.pfnUserCallback = debug_callback;
+    mi.pUserData = ctx;
+    auto fn = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
+        vkGetInstanceProcAddr(instance, "vkCreateDebugUtilsMessengerEXT"));
+    VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
+    if (fn) check(fn(instance, &mi, nullptr, &messenger), "vkCreateDebugUtilsMessengerEXT");
+    return messenger;
+}
+
+// The device `wanted` names (a part of its name or its driver's), or by default llvmpipe, else the
+// first device; EnvironmentError listing `available` when nothing matches.
+const DeviceEntry& choose_device(const std::vector<DeviceEntry>& devices, const std::string& wanted,
+                                 const std::vector<std::string>& available) {
+    for (auto& e : devices) {
+        std::string name = e.props.deviceName, drv = e.driver.driverName;
+        bool match = wanted.empty()
+                         ? (e.driver.driverID == VK_DRIVER_ID_MESA_LLVMPIPE || name.find("llvmpipe") != std::string::npos)
+                         : (name.find(wanted) != std::string::npos || drv.find(wanted) != std::string::npos);
+        if (match) return e;
+    }
+    if (wanted.empty()) return devices.front();
+    std::string list;
+    for (auto& d : available) list += "\n  " + d;
+    throw EnvironmentError("no Vulkan device matches --device '" + wanted + "'; available:" + list);
+}
+
+// Names, versions and limits of the chosen device, for provenance and for the passes.
+void describe_device(const DeviceEntry& chosen, DeviceInfo& info) {
+    info.device_name = chosen.props.deviceName;
+    info.driver_name = chosen.driver.driverName;
+    info.driver_info = chosen.driver.driverInfo;
+    info.api_version = version_string(chosen.props.apiVersion);
+    info.device_type = type_name(chosen.props.deviceType);
+    info.vendor_id = chosen.props.vendorID;
+    info.device_id = chosen.props.deviceID;
+    info.timestamp_period_ns = chosen.props.limits.timestampPeriod;
+    // Compiled once: the runner's workers create contexts concurrently, and compiling a
+    // std::regex races on libstdc++'s ctype cache (found by TSan, issue 15).
+    static const std::regex mesa_re(R"(Mesa ([0-9][0-9.]*[0-9](-[a-z0-9]+)?))");
+    static const std::regex llvm_re(R"(LLVM ([0-9][0-9.]*[0-9]))");
+    std::smatch m;
+    if (std::regex_search(info.driver_info, m, mesa_re)) info.mesa_version = m[1];
+    std::string both = info.driver_info + " " + info.device_name;
+    if (std::regex_search(both, m, llvm_re)) info.llvm_version = m[1];
+    info.standard_sample_locations = chosen.props.limits.standardSampleLocations;
+    info.color_sample_counts = chosen.props.limits.framebufferColorSampleCounts;
+    info.depth_sample_counts = chosen.props.limits.framebufferDepthSampleCounts;
+}
+
+// Queue family with compute, preferably graphics too (shading=fragment draws on it).
+uint32_t choose_queue_family(const DeviceEntry& chosen, DeviceInfo& info) {
+    uint32_t nq = 0;
+    vkGetPhysicalDeviceQueueFamilyProperties(chosen.pd, &nq, nullptr);
+    std::vector<VkQueueFamilyProperties> qf(nq);
+    vkGetPhysicalDeviceQueueFamilyProperties(chosen.pd, &nq, qf.data());
+    for (bool need_graphics : {true, false})
+        for (uint32_t i = 0; i < nq; ++i)
+            if ((qf[i].queueFlags & VK_QUEUE_COMPUTE_BIT) && (!need_graphics || (qf[i].queueFlags & VK_QUEUE_GRAPHICS_BIT))) {
+                info.timestamps = qf[i].timestampValidBits > 0 && chosen.props.limits.timestampComputeAndGraphics;
+                info.graphics = need_graphics;
+                return i;
+            }
+    throw EnvironmentError(info.device_name + ": no compute queue");
+}
+
+// The logical device with one queue of `queue_family`, VK_KHR_push_descriptor, and the features the
+// harness uses when the device has them: float16 arithmetic (precision=mediump), 16-bit storage,
+// 64-bit integers and atomics and stores from graphics stages (instruction counting).
+VkDevice create_device(VkPhysicalDevice pd, uint32_t queue_family, DeviceInfo& info) {
+    auto f11 = vk_struct<VkPhysicalDeviceVulkan11Features>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_FEATURES);
+    auto f12 = vk_struct<VkPhysicalDeviceVulkan12Features>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES);
+    f11.pNext = &f12;
+    auto f2 = vk_struct<VkPhysicalDeviceFeatures2>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2);
+    f2.pNext = &f11;
+    vkGetPhysicalDeviceFeatures2(pd, &f2);
+    info.shader_float16 = f12.shaderFloat16;
+    info.storage_16bit = f11.storageBuffer16BitAccess;
+    info.int64_atomics = f2.features.shaderInt64 && f12.shaderBufferInt64Atomics;
+    info.graphics_stores = f2.features.vertexPipelineStoresAndAtomics && f2.features.fragmentStoresAndAtomics;
+
+    auto e11 = vk_struct<VkPhysicalDeviceVulkan11Features>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_FEATURES);
+    auto e12 = vk_struct<VkPhysicalDeviceVulkan12Features>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES);
+    e11.pNext = &e12;
+    e11.storageBuffer16BitAccess = f11.storageBuffer16BitAccess;
+    e12.shaderFloat16 = f12.shaderFloat16;
+    e12.hostQueryReset = f12.hostQueryReset;
+    auto e2 = vk_struct<VkPhysicalDeviceFeatures2>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2);
+    e2.pNext = &e11;
+    e2.features.shaderInt16 = f2.features.shaderInt16;
+    e2.features.shaderFloat64 = f2.features.shaderFloat64;
+    e2.features.shaderInt64 = f2.features.shaderInt64;                  // instruction counting
+    e12.shaderBufferInt64Atomics = f12.shaderBufferInt64Atomics;
+    e2.features.vertexPipelineStoresAndAtomics = f2.features.vertexPipelineStoresAndAtomics; // counting a draw
+    e2.features.fragmentStoresAndAtomics = f2.features.fragmentStoresAndAtomics;
+
+    float prio = 1.0f;
+    auto qci = vk_struct<VkDeviceQueueCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO);
+    qci.queueFamilyIndex = queue_family;
+    qci.queueCount = 1;
+    qci.pQueuePriorities = &prio;
+    const char* dev_exts[] = {VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME};
+    auto dci = vk_struct<VkDeviceCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO);
+    dci.pNext = &e2;
+    dci.queueCreateInfoCount = 1;
+    dci.pQueueCreateInfos = &qci;
+    dci.enabledExtensionCount = 1;
+    dci.ppEnabledExtensionNames = dev_exts;
+    VkDevice device = VK_NULL_HANDLE;
+    VkResult r = vkCreateDevice(pd, &dci, nullptr, &device);
+    if (r == VK_ERROR_EXTENSION_NOT_PRESENT)
+        throw EnvironmentError(info.device_name + ": VK_KHR_push_descriptor is required and not supported");
+    check(r, "vkCreateDevice");
+    return device;
+}
+
 } // namespace
 
 void check(VkResult r, const char* what) {
@@ -146,149 +265,46 @@ Context::Context(const ContextOptions& options) {
                                "(package vulkan-validationlayers; run scripts/setup.sh)");
     instance_ = create_instance(validation);
     try {
-        if (validation) {
-            auto mi = vk_struct<VkDebugUtilsMessengerCreateInfoEXT>(VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT);
-            mi.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT |
-                                 VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT;
-            mi.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT |
-                             VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
-                             VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
-            mi.pfnUserCallback = debug_callback;
-            mi.pUserData = this;
-            auto fn = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
-                vkGetInstanceProcAddr(instance_, "vkCreateDebugUtilsMessengerEXT"));
-            if (fn) check(fn(instance_, &mi, nullptr, &messenger_), "vkCreateDebugUtilsMessengerEXT");
-        }
-
+        if (validation) messenger_ = create_messenger(instance_, this);
         auto devices = enumerate(instance_);
         if (devices.empty()) throw EnvironmentError(kNoDriverHelp);
         for (auto& e : devices) info_.available_devices.push_back(describe(e));
-        const DeviceEntry* chosen = nullptr;
-        for (auto& e : devices) {
-            std::string name = e.props.deviceName, drv = e.driver.driverName;
-            bool match = options.device.empty()
-                             ? (e.driver.driverID == VK_DRIVER_ID_MESA_LLVMPIPE || name.find("llvmpipe") != std::string::npos)
-                             : (name.find(options.device) != std::string::npos || drv.find(options.device) != std::string::npos);
-            if (match) {
-                chosen = &e;
-                break;
-            }
-        }
-        if (!chosen && options.device.empty()) chosen = &devices.front();
-        if (!chosen) {
-            std::string list;
-            for (auto& d : info_.available_devices) list += "\n  " + d;
-            throw EnvironmentError("no Vulkan device matches --device '" + options.device + "'; available:" + list);
-        }
-        physical_ = chosen->pd;
-        info_.device_name = chosen->props.deviceName;
-        info_.driver_name = chosen->driver.driverName;
-        info_.driver_info = chosen->driver.driverInfo;
-        info_.api_version = version_string(chosen->props.apiVersion);
-        info_.device_type = type_name(chosen->props.deviceType);
-        info_.vendor_id = chosen->props.vendorID;
-        info_.device_id = chosen->props.deviceID;
-        info_.timestamp_period_ns = chosen->props.limits.timestampPeriod;
+        const DeviceEntry& chosen = choose_device(devices, options.device, info_.available_devices);
+        physical_ = chosen.pd;
+        describe_device(chosen, info_);
         info_.validation = validation;
-        // Compiled once: the runner's workers create contexts concurrently, and compiling a
-        // std::regex races on libstdc++'s ctype cache (found by TSan, issue 15).
-        static const std::regex mesa_re(R"(Mesa ([0-9][0-9.]*[0-9](-[a-z0-9]+)?))");
-        static const std::regex llvm_re(R"(LLVM ([0-9][0-9.]*[0-9]))");
-        std::smatch m;
-        if (std::regex_search(info_.driver_info, m, mesa_re)) info_.mesa_version = m[1];
-        std::string both = info_.driver_info + " " + info_.device_name;
-        if (std::regex_search(both, m, llvm_re)) info_.llvm_version = m[1];
-
-        // Queue family with compute, preferably graphics too (shading=fragment draws on it).
-        uint32_t nq = 0;
-        vkGetPhysicalDeviceQueueFamilyProperties(physical_, &nq, nullptr);
-        std::vector<VkQueueFamilyProperties> qf(nq);
-        vkGetPhysicalDeviceQueueFamilyProperties(physical_, &nq, qf.data());
-        bool found = false;
-        for (bool need_graphics : {true, false}) {
-            for (uint32_t i = 0; i < nq && !found; ++i)
-                if ((qf[i].queueFlags & VK_QUEUE_COMPUTE_BIT) && (!need_graphics || (qf[i].queueFlags & VK_QUEUE_GRAPHICS_BIT))) {
-                    queue_family_ = i;
-                    info_.timestamps = qf[i].timestampValidBits > 0 && chosen->props.limits.timestampComputeAndGraphics;
-                    info_.graphics = need_graphics;
-                    found = true;
-                }
-        }
-        if (!found) throw EnvironmentError(info_.device_name + ": no compute queue");
-        info_.standard_sample_locations = chosen->props.limits.standardSampleLocations;
-        info_.color_sample_counts = chosen->props.limits.framebufferColorSampleCounts;
-        info_.depth_sample_counts = chosen->props.limits.framebufferDepthSampleCounts;
-
-        // Features the harness uses: float16 arithmetic (precision=mediump) and 16-bit storage.
-        auto f11 = vk_struct<VkPhysicalDeviceVulkan11Features>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_FEATURES);
-        auto f12 = vk_struct<VkPhysicalDeviceVulkan12Features>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES);
-        f11.pNext = &f12;
-        auto f2 = vk_struct<VkPhysicalDeviceFeatures2>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2);
-        f2.pNext = &f11;
-        vkGetPhysicalDeviceFeatures2(physical_, &f2);
-        info_.shader_float16 = f12.shaderFloat16;
-        info_.storage_16bit = f11.storageBuffer16BitAccess;
-        info_.int64_atomics = f2.features.shaderInt64 && f12.shaderBufferInt64Atomics;
-        info_.graphics_stores = f2.features.vertexPipelineStoresAndAtomics && f2.features.fragmentStoresAndAtomics;
-
-        auto e11 = vk_struct<VkPhysicalDeviceVulkan11Features>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_FEATURES);
-        auto e12 = vk_struct<VkPhysicalDeviceVulkan12Features>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES);
-        e11.pNext = &e12;
-        e11.storageBuffer16BitAccess = f11.storageBuffer16BitAccess;
-        e12.shaderFloat16 = f12.shaderFloat16;
-        e12.hostQueryReset = f12.hostQueryReset;
-        auto e2 = vk_struct<VkPhysicalDeviceFeatures2>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2);
-        e2.pNext = &e11;
-        e2.features.shaderInt16 = f2.features.shaderInt16;
-        e2.features.shaderFloat64 = f2.features.shaderFloat64;
-        e2.features.shaderInt64 = f2.features.shaderInt64;                  // instruction counting
-        e12.shaderBufferInt64Atomics = f12.shaderBufferInt64Atomics;
-        e2.features.vertexPipelineStoresAndAtomics = f2.features.vertexPipelineStoresAndAtomics; // counting a draw
-        e2.features.fragmentStoresAndAtomics = f2.features.fragmentStoresAndAtomics;
-
-        float prio = 1.0f;
-        auto qci = vk_struct<VkDeviceQueueCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO);
-        qci.queueFamilyIndex = queue_family_;
-        qci.queueCount = 1;
-        qci.pQueuePriorities = &prio;
-        const char* dev_exts[] = {VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME};
-        auto dci = vk_struct<VkDeviceCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO);
-        dci.pNext = &e2;
-        dci.queueCreateInfoCount = 1;
-        dci.pQueueCreateInfos = &qci;
-        dci.enabledExtensionCount = 1;
-        dci.ppEnabledExtensionNames = dev_exts;
-        VkResult r = vkCreateDevice(physical_, &dci, nullptr, &device_);
-        if (r == VK_ERROR_EXTENSION_NOT_PRESENT)
-            throw EnvironmentError(info_.device_name + ": VK_KHR_push_descriptor is required and not supported");
-        check(r, "vkCreateDevice");
+        queue_family_ = choose_queue_family(chosen, info_);
+        device_ = create_device(physical_, queue_family_, info_);
         vkGetDeviceQueue(device_, queue_family_, 0, &queue_);
         push_descriptor_fn_ = reinterpret_cast<PFN_vkCmdPushDescriptorSetKHR>(
             vkGetDeviceProcAddr(device_, "vkCmdPushDescriptorSetKHR"));
-
-        auto pci = vk_struct<VkCommandPoolCreateInfo>(VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO);
-        pci.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
-        pci.queueFamilyIndex = queue_family_;
-        check(vkCreateCommandPool(device_, &pci, nullptr, &pool_), "vkCreateCommandPool");
-        auto fci = vk_struct<VkFenceCreateInfo>(VK_STRUCTURE_TYPE_FENCE_CREATE_INFO);
-        check(vkCreateFence(device_, &fci, nullptr, &fence_), "vkCreateFence");
-
-        auto sci = vk_struct<VkSamplerCreateInfo>(VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO);
-        sci.magFilter = sci.minFilter = VK_FILTER_LINEAR;
-        sci.mipmapMode = VK_SAMPLER_MIPMAP_MODE_LINEAR;
-        sci.addressModeU = sci.addressModeV = sci.addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
-        sci.maxLod = VK_LOD_CLAMP_NONE;
-        check(vkCreateSampler(device_, &sci, nullptr, &linear_sampler_), "vkCreateSampler");
-        sci.addressModeU = VK_SAMPLER_ADDRESS_MODE_REPEAT; // equirect: wraps in longitude
-        check(vkCreateSampler(device_, &sci, nullptr, &equirect_sampler_), "vkCreateSampler");
-        sci.addressModeU = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
-        sci.magFilter = sci.minFilter = VK_FILTER_NEAREST;
-        sci.mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST;
-        check(vkCreateSampler(device_, &sci, nullptr, &nearest_sampler_), "vkCreateSampler");
+        create_pool_and_samplers();
     } catch (...) {
         destroy();  // the destructor does not run for a constructor that throws
         throw;
     }
+}
+
+void Context::create_pool_and_samplers() {
+    auto pci = vk_struct<VkCommandPoolCreateInfo>(VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO);
+    pci.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+    pci.queueFamilyIndex = queue_family_;
+    check(vkCreateCommandPool(device_, &pci, nullptr, &pool_), "vkCreateCommandPool");
+    auto fci = vk_struct<VkFenceCreateInfo>(VK_STRUCTURE_TYPE_FENCE_CREATE_INFO);
+    check(vkCreateFence(device_, &fci, nullptr, &fence_), "vkCreateFence");
+
+    auto sci = vk_struct<VkSamplerCreateInfo>(VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO);
+    sci.magFilter = sci.minFilter = VK_FILTER_LINEAR;
+    sci.mipmapMode = VK_SAMPLER_MIPMAP_MODE_LINEAR;
+    sci.addressModeU = sci.addressModeV = sci.addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
+    sci.maxLod = VK_LOD_CLAMP_NONE;
+    check(vkCreateSampler(device_, &sci, nullptr, &linear_sampler_), "vkCreateSampler");
+    sci.addressModeU = VK_SAMPLER_ADDRESS_MODE_REPEAT; // equirect: wraps in longitude
+    check(vkCreateSampler(device_, &sci, nullptr, &equirect_sampler_), "vkCreateSampler");
+    sci.addressModeU = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
+    sci.magFilter = sci.minFilter = VK_FILTER_NEAREST;
+    sci.mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST;
+    check(vkCreateSampler(device_, &sci, nullptr, &nearest_sampler_), "vkCreateSampler");
 }
 
 Context::~Context() { destroy(); }
@@ -334,362 +350,6 @@ bool Context::format_supports(VkFormat format, VkFormatFeatureFlags features) co
     VkFormatProperties fp;
     vkGetPhysicalDeviceFormatProperties(physical_, format, &fp);
     return (fp.optimalTilingFeatures & features) == features;
-}
-
-Buffer Context::create_buffer(VkDeviceSize size, VkBufferUsageFlags usage) {
-    Buffer b;
-    b.ctx = this;
-    b.size = size;
-    auto bci = vk_struct<VkBufferCreateInfo>(VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO);
-    bci.size = size;
-    bci.usage = usage;
-    check(vkCreateBuffer(device_, &bci, nullptr, &b.buffer), "vkCreateBuffer");
-    VkMemoryRequirements req;
-    vkGetBufferMemoryRequirements(device_, b.buffer, &req);
-    auto ai = vk_struct<VkMemoryAllocateInfo>(VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO);
-    ai.allocationSize = req.size;
-    ai.memoryTypeIndex = find_memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT |
-                                                                  VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
-    check(vkAllocateMemory(device_, &ai, nullptr, &b.memory), "vkAllocateMemory");
-    check(vkBindBufferMemory(device_, b.buffer, b.memory, 0), "vkBindBufferMemory");
-    check(vkMapMemory(device_, b.memory, 0, VK_WHOLE_SIZE, 0, &b.mapped), "vkMapMemory");
-    std::memset(b.mapped, 0, size);
-    return b;
-}
-
-Image Context::create_image(VkFormat format, uint32_t width, uint32_t height, uint32_t mips, bool cube) {
-    Image img;
-    img.ctx = this;
-    img.format = format;
-    img.width = width;
-    img.height = height;
-    img.mips = mips;
-    img.layers = cube ? 6 : 1;
-    img.cube = cube;
-    auto ici = vk_struct<VkImageCreateInfo>(VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO);
-    ici.flags = cube ? VK_IMAGE_CREATE_CUBE_COMPATIBLE_BIT : 0;
-    ici.imageType = VK_IMAGE_TYPE_2D;
-    ici.format = format;
-    ici.extent = {width, height, 1};
-    ici.mipLevels = mips;
-    ici.arrayLayers = img.layers;
-    ici.samples = VK_SAMPLE_COUNT_1_BIT;
-    ici.tiling = VK_IMAGE_TILING_OPTIMAL;
-    ici.usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT |
-                VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
-    ici.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-    check(vkCreateImage(device_, &ici, nullptr, &img.image), "vkCreateImage");
-    VkMemoryRequirements req;
-    vkGetImageMemoryRequirements(device_, img.image, &req);
-    auto ai = vk_struct<VkMemoryAllocateInfo>(VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO);
-    ai.allocationSize = req.size;
-    ai.memoryTypeIndex = find_memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-    check(vkAllocateMemory(device_, &ai, nullptr, &img.memory), "vkAllocateMemory");
-    check(vkBindImageMemory(device_, img.image, img.memory, 0), "vkBindImageMemory");
-
-    auto vci = vk_struct<VkImageViewCreateInfo>(VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO);
-    vci.image = img.image;
-    vci.viewType = cube ? VK_IMAGE_VIEW_TYPE_CUBE : VK_IMAGE_VIEW_TYPE_2D;
-    vci.format = format;
-    vci.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, mips, 0, img.layers};
-    check(vkCreateImageView(device_, &vci, nullptr, &img.sampled_view), "vkCreateImageView");
-    for (uint32_t m = 0; m < mips; ++m) {
-        vci.viewType = cube ? VK_IMAGE_VIEW_TYPE_2D_ARRAY : VK_IMAGE_VIEW_TYPE_2D;
-        vci.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, m, 1, 0, img.layers};
-        VkImageView v;
-        check(vkCreateImageView(device_, &vci, nullptr, &v), "vkCreateImageView");
-        img.storage_views.push_back(v);
-    }
-    return img;
-}
-
-Buffer& Buffer::operator=(Buffer&& o) noexcept {
-    std::swap(ctx, o.ctx);
-    std::swap(buffer, o.buffer);
-    std::swap(memory, o.memory);
-    std::swap(size, o.size);
-    std::swap(mapped, o.mapped);
-    return *this;
-}
-
-Buffer::~Buffer() {
-    if (!ctx) return;
-    if (buffer) vkDestroyBuffer(ctx->device(), buffer, nullptr);
-    if (memory) vkFreeMemory(ctx->device(), memory, nullptr);
-}
-
-Image& Image::operator=(Image&& o) noexcept {
-    std::swap(ctx, o.ctx);
-    std::swap(image, o.image);
-    std::swap(memory, o.memory);
-    std::swap(format, o.format);
-    std::swap(width, o.width);
-    std::swap(height, o.height);
-    std::swap(mips, o.mips);
-    std::swap(layers, o.layers);
-    std::swap(cube, o.cube);
-    std::swap(sampled_view, o.sampled_view);
-    std::swap(storage_views, o.storage_views);
-    return *this;
-}
-
-Image::~Image() {
-    if (!ctx) return;
-    for (auto v : storage_views) vkDestroyImageView(ctx->device(), v, nullptr);
-    if (sampled_view) vkDestroyImageView(ctx->device(), sampled_view, nullptr);
-    if (image) vkDestroyImage(ctx->device(), image, nullptr);
-    if (memory) vkFreeMemory(ctx->device(), memory, nullptr);
-}
-
-VkCommandBuffer Context::begin_commands() {
-    auto ai = vk_struct<VkCommandBufferAllocateInfo>(VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO);
-    ai.commandPool = pool_;
-    ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-    ai.commandBufferCount = 1;
-    VkCommandBuffer cmd;
-    check(vkAllocateCommandBuffers(device_, &ai, &cmd), "vkAllocateCommandBuffers");
-    auto bi = vk_struct<VkCommandBufferBeginInfo>(VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO);
-    bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-    check(vkBeginCommandBuffer(cmd, &bi), "vkBeginCommandBuffer");
-    return cmd;
-}
-
-void Context::end_and_wait(VkCommandBuffer cmd) {
-    check(vkEndCommandBuffer(cmd), "vkEndCommandBuffer");
-    auto si = vk_struct<VkSubmitInfo>(VK_STRUCTURE_TYPE_SUBMIT_INFO);
-    si.commandBufferCount = 1;
-    si.pCommandBuffers = &cmd;
-    check(vkQueueSubmit(queue_, 1, &si, fence_), "vkQueueSubmit");
-    check(vkWaitForFences(device_, 1, &fence_, VK_TRUE, UINT64_MAX), "vkWaitForFences");
-    check(vkResetFences(device_, 1, &fence_), "vkResetFences");
-    vkFreeCommandBuffers(device_, pool_, 1, &cmd);
-}
-
-void Context::barrier(VkCommandBuffer cmd) {
-    auto mb = vk_struct<VkMemoryBarrier>(VK_STRUCTURE_TYPE_MEMORY_BARRIER);
-    mb.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
-    mb.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT |
-                       VK_ACCESS_HOST_READ_BIT;
-    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
-                         VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT |
-                             VK_PIPELINE_STAGE_HOST_BIT,
-                         0, 1, &mb, 0, nullptr, 0, nullptr);
-}
-
-void Context::transition(VkCommandBuffer cmd, const Image& img, VkImageLayout from, VkImageLayout to) {
-    auto b = vk_struct<VkImageMemoryBarrier>(VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER);
-    b.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
-    b.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
-    b.oldLayout = from;
-    b.newLayout = to;
-    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-    b.image = img.image;
-    b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, img.mips, 0, img.layers};
-    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
-                         VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr, 0,
-                         nullptr, 1, &b);
-}
-
-void Context::copy_buffer_to_image(VkCommandBuffer cmd, const Buffer& src, const Image& dst, uint32_t mip) {
-    VkBufferImageCopy r{};
-    r.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, mip, 0, dst.layers};
-    r.imageExtent = {std::max(1u, dst.width >> mip), std::max(1u, dst.height >> mip), 1};
-    vkCmdCopyBufferToImage(cmd, src.buffer, dst.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &r);
-}
-
-namespace {
-float half_to_float(uint16_t h) {
-    uint32_t sign = uint32_t(h >> 15) << 31, exp = (h >> 10) & 0x1f, mant = h & 0x3ff, bits;
-    if (exp == 0) {
-        if (mant == 0) bits = sign;
-        else {  // subnormal
-            int e = -1;
-            do { ++e; mant <<= 1; } while (!(mant & 0x400));
-            bits = sign | uint32_t(127 - 15 - e) << 23 | (mant & 0x3ff) << 13;
-        }
-    } else if (exp == 31) {
-        bits = sign | 0x7f800000u | mant << 13;
-    } else {
-        bits = sign | (exp + 112) << 23 | mant << 13;
-    }
-    float f;
-    std::memcpy(&f, &bits, 4);
-    return f;
-}
-} // namespace
-
-std::vector<float> Context::download(const Image& img, uint32_t mip) {
-    uint32_t w = std::max(1u, img.width >> mip), h = std::max(1u, img.height >> mip);
-    size_t texels = size_t(w) * h * img.layers;
-    size_t bpp = img.format == VK_FORMAT_R32G32B32A32_SFLOAT ? 16 : img.format == VK_FORMAT_R16G16B16A16_SFLOAT ? 8
-               : img.format == VK_FORMAT_R16G16_SFLOAT ? 4 : 0;
-    if (!bpp) throw Error("Context::download: unsupported image format");
-    Buffer buf = create_buffer(texels * bpp, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
-    submit([&](VkCommandBuffer cmd) {
-        barrier(cmd);
-        VkBufferImageCopy r{};
-        r.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, mip, 0, img.layers};
-        r.imageExtent = {w, h, 1};
-        vkCmdCopyImageToBuffer(cmd, img.image, VK_IMAGE_LAYOUT_GENERAL, buf.buffer, 1, &r);
-        barrier(cmd);
-    });
-    std::vector<float> out(texels * 4);
-    if (bpp == 16) {
-        std::memcpy(out.data(), buf.mapped, texels * 16);
-    } else {
-        const uint16_t* hp = static_cast<const uint16_t*>(buf.mapped);
-        for (size_t i = 0; i < texels; ++i) {
-            if (bpp == 8)
-                for (int c = 0; c < 4; ++c) out[4 * i + c] = half_to_float(hp[4 * i + c]);
-            else {
-                out[4 * i] = half_to_float(hp[2 * i]);
-                out[4 * i + 1] = half_to_float(hp[2 * i + 1]);
-                out[4 * i + 2] = 0;
-                out[4 * i + 3] = 1;
-            }
-        }
-    }
-    return out;
-}
-
-ComputePipeline::ComputePipeline(Context& ctx, const CompiledShader& shader,
-                                 const std::vector<VkDescriptorType>& bindings, uint32_t push_constant_bytes,
-                                 const std::vector<SpecConstant>& spec)
-    : ctx_(ctx), push_bytes_(push_constant_bytes) {
-    VkDevice dev = ctx.device();
-    std::vector<VkDescriptorSetLayoutBinding> lb;
-    for (uint32_t i = 0; i < bindings.size(); ++i)
-        lb.push_back({i, bindings[i], 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr});
-    if (shader.counts_instructions && bindings.size() > kCostBinding)
-        throw Error("ComputePipeline: binding " + std::to_string(kCostBinding) + " is the instruction counter's");
-    if (shader.counts_instructions)
-        lb.push_back({kCostBinding, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr});
-    auto dl = vk_struct<VkDescriptorSetLayoutCreateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO);
-    dl.flags = VK_DESCRIPTOR_SET_LAYOUT_CREATE_PUSH_DESCRIPTOR_BIT_KHR;
-    dl.bindingCount = uint32_t(lb.size());
-    dl.pBindings = lb.data();
-    check(vkCreateDescriptorSetLayout(dev, &dl, nullptr, &set_layout_), "vkCreateDescriptorSetLayout");
-    VkPushConstantRange pcr{VK_SHADER_STAGE_COMPUTE_BIT, 0, push_constant_bytes};
-    auto pl = vk_struct<VkPipelineLayoutCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO);
-    pl.setLayoutCount = 1;
-    pl.pSetLayouts = &set_layout_;
-    pl.pushConstantRangeCount = push_constant_bytes ? 1 : 0;
-    pl.pPushConstantRanges = &pcr;
-    check(vkCreatePipelineLayout(dev, &pl, nullptr, &layout_), "vkCreatePipelineLayout");
-
-    auto smi = vk_struct<VkShaderModuleCreateInfo>(VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO);
-    smi.codeSize = shader.spirv.size() * 4;
-    smi.pCode = shader.spirv.data();
-    VkShaderModule module;
-    check(vkCreateShaderModule(dev, &smi, nullptr, &module), "vkCreateShaderModule");
-    std::vector<VkSpecializationMapEntry> entries;
-    std::vector<uint32_t> data;
-    for (auto& s : spec) {
-        entries.push_back({s.id, uint32_t(data.size() * 4), 4});
-        data.push_back(s.value);
-    }
-    VkSpecializationInfo si{uint32_t(entries.size()), entries.data(), data.size() * 4, data.data()};
-    auto ci = vk_struct<VkComputePipelineCreateInfo>(VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO);
-    ci.stage = vk_struct<decltype(ci.stage)>(VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO);
-    ci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
-    ci.stage.module = module;
-    ci.stage.pName = "main";
-    ci.stage.pSpecializationInfo = entries.empty() ? nullptr : &si;
-    ci.layout = layout_;
-    VkResult r = vkCreateComputePipelines(dev, VK_NULL_HANDLE, 1, &ci, nullptr, &pipeline_);
-    vkDestroyShaderModule(dev, module, nullptr);
-    check(r, "vkCreateComputePipelines");
-}
-
-ComputePipeline::~ComputePipeline() {
-    VkDevice dev = ctx_.device();
-    if (pipeline_) vkDestroyPipeline(dev, pipeline_, nullptr);
-    if (layout_) vkDestroyPipelineLayout(dev, layout_, nullptr);
-    if (set_layout_) vkDestroyDescriptorSetLayout(dev, set_layout_, nullptr);
-}
-
-void Context::push_descriptors(VkCommandBuffer cmd, VkPipelineBindPoint bind_point, VkPipelineLayout layout,
-                               const std::vector<Binding>& bindings) const {
-    if (bindings.empty()) return;  // zero writes is invalid usage
-    std::vector<VkWriteDescriptorSet> writes(bindings.size());
-    std::vector<VkDescriptorBufferInfo> bufs(bindings.size());
-    std::vector<VkDescriptorImageInfo> imgs(bindings.size());
-    for (size_t i = 0; i < bindings.size(); ++i) {
-        const Binding& b = bindings[i];
-        VkWriteDescriptorSet& w = writes[i];
-        w = vk_struct<decltype(w)>(VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET);
-        w.dstBinding = b.binding;
-        w.descriptorCount = 1;
-        w.descriptorType = b.type;
-        if (b.type == VK_DESCRIPTOR_TYPE_STORAGE_BUFFER || b.type == VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER) {
-            bufs[i] = {b.buffer, 0, VK_WHOLE_SIZE};
-            w.pBufferInfo = &bufs[i];
-        } else {
-            imgs[i] = {b.sampler, b.view, b.layout};
-            w.pImageInfo = &imgs[i];
-        }
-    }
-    push_descriptor_fn_(cmd, bind_point, layout, 0, uint32_t(writes.size()), writes.data());
-}
-
-void ComputePipeline::dispatch(VkCommandBuffer cmd, const std::vector<Binding>& bindings, const void* push,
-                               uint32_t push_bytes, uint32_t gx, uint32_t gy, uint32_t gz) const {
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);
-    ctx_.push_descriptors(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, bindings);
-    if (push && push_bytes) vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, push_bytes, push);
-    vkCmdDispatch(cmd, gx, gy, gz);
-}
-
-void ComputePipeline::warm_up(VkCommandBuffer cmd, const std::vector<Binding>& bindings, const void* push,
-                              uint32_t push_bytes) const {
-    if (warmed_) return;
-    warmed_ = true;
-    dispatch(cmd, bindings, push, push_bytes, 1, 1, 1);
-    Context::barrier(cmd);
-}
-
-// Queries per pass: begin, the marker that resolves it (see context.h), end.
-constexpr uint32_t kQueriesPerPass = 3;
-
-GpuTimer::GpuTimer(Context& ctx, uint32_t max_passes) : ctx_(ctx), max_(max_passes) {
-    auto qi = vk_struct<VkQueryPoolCreateInfo>(VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO);
-    qi.queryType = VK_QUERY_TYPE_TIMESTAMP;
-    qi.queryCount = kQueriesPerPass * max_passes;
-    check(vkCreateQueryPool(ctx.device(), &qi, nullptr, &pool_), "vkCreateQueryPool");
-}
-
-GpuTimer::~GpuTimer() {
-    if (pool_) vkDestroyQueryPool(ctx_.device(), pool_, nullptr);
-}
-
-void GpuTimer::reset(VkCommandBuffer cmd) {
-    vkCmdResetQueryPool(cmd, pool_, 0, kQueriesPerPass * max_);
-    names_.clear();
-}
-
-void GpuTimer::begin(VkCommandBuffer cmd, const std::string& name) {
-    if (names_.size() >= max_) throw Error("GpuTimer: more passes than reserved");
-    const uint32_t q = uint32_t(kQueriesPerPass * names_.size());
-    vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, pool_, q);
-    vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, pool_, q + 1);  // resolves q on lavapipe
-    names_.push_back(name);
-}
-
-void GpuTimer::end(VkCommandBuffer cmd) {
-    vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, pool_, uint32_t(kQueriesPerPass * names_.size() - 1));
-}
-
-std::vector<std::pair<std::string, double>> GpuTimer::results() const {
-    std::vector<std::pair<std::string, double>> out;
-    if (names_.empty()) return out;
-    std::vector<uint64_t> ts(kQueriesPerPass * names_.size());
-    check(vkGetQueryPoolResults(ctx_.device(), pool_, 0, uint32_t(ts.size()), ts.size() * 8, ts.data(), 8,
-                                VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
-          "vkGetQueryPoolResults");
-    for (size_t i = 0; i < names_.size(); ++i)
-        out.emplace_back(names_[i], double(ts[kQueriesPerPass * i + 2] - ts[kQueriesPerPass * i]) *
-                                        ctx_.info().timestamp_period_ns * 1e-6);
-    return out;
 }
 
 } // namespace iblcheck::vk

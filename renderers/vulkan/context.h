@@ -1,7 +1,9 @@
 // The Vulkan plumbing, nothing IBL-specific: a headless instance and device (no window system),
 // device selection (lavapipe by default: deterministic and on every CI machine), validation with an
 // error counter, buffers/images, compute pipelines with push descriptors, and timestamp queries.
-// Graphics pipelines and offscreen MSAA targets are in graphics_pipeline.h.
+// Graphics pipelines and offscreen MSAA targets are in graphics_pipeline.h. Defined by job:
+// context.cpp (instance, device selection and creation), resources.cpp (buffers, images, commands,
+// transfers), compute_pipeline.cpp, gpu_timer.cpp.
 #pragma once
 #include <vulkan/vulkan.h>
 
@@ -211,6 +213,7 @@ class Context {
     uint32_t find_memory_type(uint32_t bits, VkMemoryPropertyFlags props) const;
 
   private:
+    void create_pool_and_samplers();
     void destroy();
 
     DeviceInfo info_;

@@ -1,0 +1,10 @@
+// The importance-sampled peer (Substance Painter's approach, third seed): the estimator is
+// shaders/shade_sampled.comp; it reuses the mobile pipeline's source pyramid, SH9 and scene upload.
+#pragma once
+#include "renderers/environments/environment.h"
+#include "renderers/mobile/gpu_session.h"
+#include "renderers/render_api.h"
+
+namespace iblcheck {
+RenderResult render_sampled(GpuSession& gpu, const Environment& env, const TestSpec& spec);
+}
