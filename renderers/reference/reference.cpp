@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 
 #include "renderers/material_model.h"
+#include "renderers/reference/truth_renderer.h"
 
 namespace iblcheck {
 
@@ -1011,8 +1012,17 @@ ReferenceRender render_reference_full(const TestSpec& spec, const Environment* e
     return out;
 }
 
-RenderResult render_reference(const TestSpec& spec) { return render_reference_full(spec).result; }
+bool uses_quadrature(const TestSpec& spec) {
+    return spec.options.get_choice("integrator", spec.options.has("spp") ? "monte_carlo" : "quadrature",
+                                   {"quadrature", "monte_carlo"}) == "quadrature";
+}
+
+RenderResult render_reference(const TestSpec& spec) {
+    if (uses_quadrature(spec)) return truth::render_truth(spec, load_environment(spec.env)).result;
+    return render_reference_full(spec).result;
+}
 RenderResult render_reference(const TestSpec& spec, const Environment& env) {
+    if (uses_quadrature(spec)) return truth::render_truth(spec, env).result;
     return render_reference_full(spec, &env).result;
 }
 

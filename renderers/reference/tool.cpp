@@ -4,8 +4,6 @@
 // --noise-floor renders a second image with seed K+1 and records the relative RMSE between the two
 // (reference.h, measure_noise_floor); the golden written is the seed-K image. --tiles WxH also prints the
 // noise floor per WxH tile (48x48 = one sphere of the roughness sweep), to see where the noise is.
-#include <OpenImageIO/imageio.h>
-
 #include <chrono>
 #include <cstdio>
 #include <ctime>
@@ -13,20 +11,44 @@
 #include <iostream>
 
 #include "metrics/flip.h"
+#include "metrics/image_io.h"
 #include "renderers/reference/reference.h"
+#include "renderers/reference/truth_golden.h"
 
 using namespace iblcheck;
 
-static void write_exr(const std::string& path, const cv::Mat& img) {
-    auto out = OIIO::ImageOutput::create(path);
-    if (!out) throw InputError("cannot create " + path + ": " + OIIO::geterror());
-    OIIO::ImageSpec spec(img.cols, img.rows, 3, OIIO::TypeDesc::FLOAT);
-    spec.attribute("compression", "zip");
-    if (!out->open(path, spec)) throw InputError("cannot open " + path + ": " + out->geterror());
-    cv::Mat c = img.isContinuous() ? img : img.clone();
-    if (!out->write_image(OIIO::TypeDesc::FLOAT, c.ptr<float>(0)))
-        throw InputError("cannot write " + path + ": " + out->geterror());
-    out->close();
+
+// --truth: the quadrature truth (truth_golden.h): golden + sidecar; --compare OLD.exr prints the mean FLIP
+// and relative RMSE between the new golden and OLD (the check against the committed golden).
+static int run_truth(TestSpec spec, const std::string& out_path, const std::string& command, const std::string& compare_path) {
+    truth::GoldenRequest req;
+    req.spec = spec;
+    req.out_exr = out_path;
+    req.command = command;
+    const truth::GoldenWritten g = truth::write_truth_golden(req);
+    const auto& b = g.meta["error_bound"];
+    std::printf("%s: %dx%d time=%.1fs bound: rel_rmse=%.5f%% mean_flip=%.5f worst_pixel=%.5f worst_rel=%.5f criterion=%s\n",
+                out_path.c_str(), g.meta["width"].get<int>(), g.meta["height"].get<int>(), g.meta["time_s"].get<double>(),
+                100 * b["relative_rmse"].get<double>(), g.mean_flip, b["worst_pixel"].get<double>(),
+                b["worst_pixel_relative"].get<double>(), g.criterion_met ? "met" : "NOT met");
+    for (const auto& s : b["per_sphere"])
+        std::printf("  %-16s rel_rmse=%.5f%% flip=%.5f worst=%.5f worst_rel=%.5f\n", s["label"].get<std::string>().c_str(),
+                    100 * s["relative_rmse"].get<double>(), s["mean_flip"].get<double>(), s["worst_pixel"].get<double>(),
+                    s["worst_pixel_relative"].get<double>());
+    if (!compare_path.empty()) {
+        const cv::Mat a = read_image(out_path).pixels, o = read_image(compare_path).pixels;
+        check_same_size(a, o, out_path, compare_path);
+        cv::Mat cov(a.rows, a.cols, CV_32FC1, cv::Scalar(0)); // covered: the truth's background is exactly 0
+        for (int y = 0; y < a.rows; ++y)
+            for (int x = 0; x < a.cols; ++x) {
+                const cv::Vec3f& p = a.at<cv::Vec3f>(y, x);
+                if (p[0] > 0 || p[1] > 0 || p[2] > 0) cov.at<float>(y, x) = 1;
+            }
+        const FlipResult fr = compute_flip_hdr(o, a, FlipOptions{});
+        std::printf("against %s: mean FLIP %.5f, relative RMSE %.4f%%\n", compare_path.c_str(), fr.mean,
+                    100 * relative_rmse(a, o, cov));
+    }
+    return 0;
 }
 
 int main(int argc, char** argv) {
@@ -34,7 +56,8 @@ int main(int argc, char** argv) {
         TestSpec spec;
         spec.method = "reference";
         std::string out_path, meta_path, command;
-        bool noise = false;
+        bool noise = false, truth = false;
+        std::string compare_path;
         int tile_w = 0, tile_h = 0;
         int spp = kReferenceDefaultSpp, seed = 0;
         for (int i = 1; i < argc; ++i) {
@@ -55,6 +78,8 @@ int main(int argc, char** argv) {
             else if (a == "--meta") meta_path = next();
             else if (a == "--noise-floor") noise = true;
             else if (a == "--command") command = next();
+            else if (a == "--truth") truth = true;
+            else if (a == "--compare") compare_path = next();
             else if (a == "--tiles") {
                 std::string t = next();
                 if (std::sscanf(t.c_str(), "%dx%d", &tile_w, &tile_h) != 2 || tile_w < 1 || tile_h < 1)
@@ -63,6 +88,7 @@ int main(int argc, char** argv) {
             else throw UsageError("unknown argument '" + a + "' (see the comment at the top of tool.cpp)");
         }
         if (out_path.empty()) throw UsageError("--out FILE.exr is required");
+        if (truth) return run_truth(spec, out_path, command, compare_path);
         spp = spec.options.get_int("spp", spp);
         seed = spec.options.get_int("seed", seed);
         auto t0 = std::chrono::steady_clock::now();

@@ -1,0 +1,36 @@
+// Writes one quadrature-truth golden: the EXR and its JSON sidecar, with the error bound (the two
+// refinement levels' difference as relative RMSE, mean FLIP, per sphere and worst pixel) and issue
+// 16's criterion verdict. Shared by `iblcheck truth` and iblcheck_reference_tool (the regeneration
+// script). Links the metrics (FLIP), which the integrator itself does not.
+#pragma once
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "renderers/reference/truth_renderer.h"
+
+namespace iblcheck::truth {
+
+inline constexpr double kCriterionFlip = 0.002;
+inline constexpr double kCriterionRelativeRmse = 0.005;
+
+struct GoldenRequest {
+    TestSpec spec;          // method reference; the environment is loaded from spec.env
+    std::string out_exr;    // the golden; the sidecar is the same path with .json
+    std::string command;    // recorded as the regenerating command
+    Progress progress;      // optional
+};
+
+struct GoldenWritten {
+    nlohmann::json meta;    // the sidecar's content
+    double mean_flip = 0;   // between the two levels
+    bool criterion_met = false;
+};
+
+GoldenWritten write_truth_golden(const GoldenRequest& request);
+
+// The environment as recorded in a sidecar: its spec, but a file path reduced to its file name (no
+// absolute machine paths in goldens), with the content hash that identifies it.
+std::string portable_env_spec(const std::string& spec);
+
+} // namespace iblcheck::truth
