@@ -16,7 +16,7 @@ constexpr int kDeepest = 14;
 constexpr double kGuardReach = 8;
 // Across the plane of incidence the lobe narrows as n·v; the guard stops following it below this n·v
 // (grazing points cover little of the image, and the indicator still refines where they need it).
-constexpr double kMinWidthNv = 0.05; // sub-texel levels: a texel splits into at most 2^14 x 2^14 cells
+constexpr double kMinWidthNv = 0.25; // sub-texel levels: a texel splits into at most 2^14 x 2^14 cells
 
 // The part of a cell above the horizon of n, the cell taken as its tangent-plane rectangle (second
 // order in its size): n·l ≈ d + a·x + b·y is clipped against the rectangle (Sutherland–Hodgman);
@@ -47,6 +47,35 @@ double clip_above_horizon(const EnvPyramid::Rect& r, V3 n, V3& centroid) {
     return area / (4 * r.hx * r.hy);
 }
 
+// f·cos⁺ (truth_math.h, fcos) at four directions at once: structure-of-arrays and branch-free (the
+// horizon is a max(0, ·) mask), so the compiler vectorises it; GCC's target_clones adds an AVX2+FMA
+// version picked at run time on machines that have it (the results differ from the default version's
+// in the last bits; each is deterministic).
+__attribute__((target_clones("arch=haswell", "default"))) void fcos4(const MaterialLobe& L, const ShadingPoint& s,
+                                                                      const double* lx, const double* ly,
+                                                                      const double* lz, double out[3][4]) {
+    double nl[4];
+    for (int k = 0; k < 4; ++k) nl[k] = std::max(0.0, s.n.x * lx[k] + s.n.y * ly[k] + s.n.z * lz[k]);
+    for (int q = 0; q < 3; ++q)
+        for (int k = 0; k < 4; ++k) out[q][k] = L.kd[q] * nl[k];
+    if (!L.glossy()) return;
+    const double a2 = L.a2;
+    double dvn[4], x5[4];
+    for (int k = 0; k < 4; ++k) {
+        const double hx = lx[k] + s.v.x, hy = ly[k] + s.v.y, hz = lz[k] + s.v.z;
+        const double inv = 1.0 / std::sqrt(hx * hx + hy * hy + hz * hz + 1e-300);
+        const double nh = (s.n.x * hx + s.n.y * hy + s.n.z * hz) * inv, vh = (s.v.x * hx + s.v.y * hy + s.v.z * hz) * inv;
+        const double t = nh * nh * (a2 - 1) + 1;
+        const double d = a2 / (kPi * t * t);
+        const double vis = 0.5 / (nl[k] * s.gv + s.nv * std::sqrt(nl[k] * nl[k] * (1 - a2) + a2));
+        const double x = 1 - std::min(1.0, std::max(0.0, vh));
+        x5[k] = x * x * x * x * x;
+        dvn[k] = d * vis * nl[k];
+    }
+    for (int q = 0; q < 3; ++q)
+        for (int k = 0; k < 4; ++k) out[q][k] += dvn[k] * (L.f0[q] + (1 - L.f0[q]) * x5[k]);
+}
+
 // A cell of the pyramid (level ≥ 0) or a sub-texel cell (level −s: texel (i, j), sub-cell (a, b) of
 // 2^s × 2^s), with its estimates (adaptive_refine.h's Region).
 struct EnvRegion {
@@ -66,34 +95,9 @@ struct Integrand {
     const QuadratureParams& p;
     V3 peak;              // mirror direction: the GGX lobe's core
     double cos_guard_w;   // cos(κ·w)
-    double w;             // the lobe's width (the far part: the window's transition width)
+    double w;             // the lobe's width
     bool guard;
-    double one_minus_cos_window = 0; // 1 − cos(window radius)
     long evals = 0;
-
-    // The near/far split's weights of the specular term at direction l (lobe_quadrature.h): W(σ),
-    // σ = (1 − l·peak)/(1 − cos R) (≈ (angle/R)²), W = 1 for σ ≤ 1/4, 0 for σ ≥ 1, quintic smoothstep
-    // in u = (1 − σ)/(3/4) between; its complement for the far part.
-    void f(V3 l, double out[3]) const {
-        if (p.part == LobePart::whole) return fcos(lobe, s, l, out);
-        const double sig = (1 - dot(l, peak)) / one_minus_cos_window;
-        double W = 1;
-        if (sig >= 1) W = 0;
-        else if (sig > 0.25) {
-            const double u = (1 - sig) / 0.75;
-            W = u * u * u * (10 - 15 * u + 6 * u * u);
-        }
-        if (p.part == LobePart::near) fcos(lobe, s, l, out, W, 0.0);
-        else fcos(lobe, s, l, out, 1 - W, 1.0);
-    }
-    // The near part: is the cell (geometric centre g, cos of radius cr) outside the window?
-    bool outside_window(V3 g, double cr) const {
-        if (p.part != LobePart::near) return false;
-        const double cw = 1 - one_minus_cos_window, sw = std::sqrt(std::max(0.0, 1 - cw * cw));
-        const double sr = std::sqrt(std::max(0.0, 1 - cr * cr));
-        const double cos_sum = cw * cr - sw * sr; // cos(R + radius)
-        return std::acos(std::clamp(cw, -1.0, 1.0)) + std::acos(std::clamp(cr, -1.0, 1.0)) < kPi && dot(g, peak) < cos_sum;
-    }
 
     // A cell's estimate; false if the cell is entirely below the horizon or black (no region). Levels
     // ≥ 0: four points matching the cell's luminance-weighted mean direction c and second moment C
@@ -124,31 +128,35 @@ struct Integrand {
         }
         const double sr = std::sqrt(std::max(0.0, 1 - cr * cr)), h = dot(g, s.n);
         if (h < -sr) return false; // angle to n > 90° + radius
-        if (outside_window(g, cr)) return false;
         if (h < sr) { // straddles the horizon
             V3 c;
             const double frac = clip_above_horizon(env.rect(level, i, j, a, b), s.n, c);
             if (frac <= 0) return false;
             ++evals;
-            this->f(c, f);
+            fcos(lobe, s, c, f);
             for (int q = 0; q < 3; ++q) e[q] = f[q] * L[q] * frac;
             return true;
         }
         e[0] = e[1] = e[2] = 0;
+        double lx[4], ly[4], lz[4], f4[3][4];
         if (level < 0) {
-            for (int k = 0; k < 4; ++k) {
-                this->f(pts[k], f);
-                for (int q = 0; q < 3; ++q) e[q] += f[q] * wL[k][q];
-            }
+            for (int k = 0; k < 4; ++k) lx[k] = pts[k].x, ly[k] = pts[k].y, lz[k] = pts[k].z;
+            fcos4(lobe, s, lx, ly, lz, f4);
+            for (int k = 0; k < 4; ++k)
+                for (int q = 0; q < 3; ++q) e[q] += f4[q][k] * wL[k][q];
             evals += 4;
             return true;
         }
-        for (int k = 0; k < cell->np; ++k) {
-            this->f(V3{cell->sp[k][0], cell->sp[k][1], cell->sp[k][2]}, f);
-            for (int q = 0; q < 3; ++q) e[q] += f[q];
+        if (cell->np == 1) {
+            fcos(lobe, s, V3{cell->sp[0][0], cell->sp[0][1], cell->sp[0][2]}, f);
+            for (int q = 0; q < 3; ++q) e[q] = f[q] * L[q];
+            ++evals;
+            return true;
         }
-        evals += cell->np;
-        for (int q = 0; q < 3; ++q) e[q] *= L[q] / cell->np;
+        for (int k = 0; k < 4; ++k) lx[k] = cell->sp[k][0], ly[k] = cell->sp[k][1], lz[k] = cell->sp[k][2];
+        fcos4(lobe, s, lx, ly, lz, f4);
+        for (int q = 0; q < 3; ++q) e[q] = 0.25 * L[q] * (f4[q][0] + f4[q][1] + f4[q][2] + f4[q][3]);
+        evals += 4;
         return true;
     }
 
@@ -243,36 +251,17 @@ void shade(const EnvPyramid& env, const MaterialLobe& lobe, const ShadingPoint& 
         for (int q = 0; q < 3; ++q) rgb[q] += model::f_schlick(lobe.f0[q], s.nv) * L[q];
     }
     if (!lobe.diffuse && !lobe.glossy()) return;
-    if (p.part == LobePart::near && !lobe.glossy()) return;
     Integrand in{env, lobe, s, p, 2 * s.nv * s.n - s.v, 1, 0, lobe.glossy()};
     in.w = 2 * lobe.alpha * std::max(s.nv, kMinWidthNv);
-    if (p.part != LobePart::whole) {
-        const double R = std::min(kPi / 2, p.window * in.w);
-        in.one_minus_cos_window = 1 - std::cos(R);
-        if (p.part == LobePart::far) in.w = std::max(in.w, R / 4); // the window's transition: its finest feature
-    }
     in.cos_guard_w = std::cos(p.kappa * in.w);
     thread_local std::vector<EnvRegion> heap;
     heap.clear();
     const int top = env.top_level();
-    if (p.part == LobePart::near) {
-        // Only the window matters: start from the cells of the level about half its radius wide.
-        const double R = std::acos(1 - in.one_minus_cos_window);
-        int level = top;
-        while (level > 0 && env.cell_angle(level) > R / 2) --level;
-        thread_local std::vector<std::pair<int, int>> cells;
-        env.cone_cells(in.peak, R, level, cells);
-        for (auto [i, j] : cells) {
+    for (int j = 0; j < env.height(top); ++j)
+        for (int i = 0; i < env.width(top); ++i) {
             double e[3];
-            if (in.estimate(level, i, j, 0, 0, e)) heap.push_back(in.region(level, i, j, 0, 0, e));
+            if (in.estimate(top, i, j, 0, 0, e)) heap.push_back(in.region(top, i, j, 0, 0, e));
         }
-    } else {
-        for (int j = 0; j < env.height(top); ++j)
-            for (int i = 0; i < env.width(top); ++i) {
-                double e[3];
-                if (in.estimate(top, i, j, 0, 0, e)) heap.push_back(in.region(top, i, j, 0, 0, e));
-            }
-    }
     auto split = [&](const EnvRegion& parent, std::vector<EnvRegion>& out) {
         EnvRegion r = parent;
         if (r.lazy) in.evaluate_children(r);

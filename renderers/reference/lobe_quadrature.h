@@ -19,15 +19,7 @@
 
 namespace iblcheck::truth {
 
-// A narrow glossy lobe can be split exactly into a near part — the specular term times a smooth window
-// W about the mirror direction (1 within half its radius, 0 beyond it, C² in between) — and a far
-// part: the diffuse term plus the specular term times 1 − W. The far part varies smoothly with the
-// normal (on the window's scale), the near part is cheap (only cells inside the window).
-enum class LobePart { whole, near, far };
-
 struct QuadratureParams {
-    LobePart part = LobePart::whole;
-    double window = 8;       // the window's radius, in lobe widths w
     double tolerance = 1e-3; // relative (indicator sum / (value + floor))
     double floor = 0;        // absolute radiance added to the value in the tolerance
     double kappa = 0.5;      // lobe guard: cells on the lobe's core are split until radius ≤ κ·w

@@ -33,21 +33,30 @@ struct NormalTable::Builder {
     double floor_ = 0;
     long nodes = 0, evals = 0;
 
-    void value(double X, double Y, float out[3]) {
+    // The shading at (X, Y), a node of cells of size s (0: the coarse grid).
+    void value(double X, double Y, float out[3], double s = 0) {
         double rgb[3] = {0, 0, 0};
         ShadeStats st;
-        shade(env, lobe, shading_point(t.from_map(X, Y), t.v_, lobe), qp, rgb, &st);
+        const V3 n = t.from_map(X, Y);
+        QuadratureParams q = qp;
+        // Grazing normals cover little of the image (∝ n·v): their quadrature may be as much looser. Nodes
+        // of cells smaller than a pixel's footprint enter a pixel (footprint/s)² at a time, their errors
+        // (each from its own refinement) averaging as footprint/s: they may be as much looser too.
+        q.tolerance /= std::clamp(dot(n, t.v_) + tp.weight_offset, 0.05, 1.0);
+        if (s > 0 && s < tp.footprint) q.tolerance *= tp.footprint / s;
+        shade(env, lobe, shading_point(n, t.v_, lobe), q, rgb, &st);
         ++nodes, evals += st.evaluations;
         for (int q = 0; q < 3; ++q) out[q] = float(rgb[q]);
     }
 
     // A glossy lobe narrower than the cell, with radiance in the cell's reflection cone (its corners'
-    // reflections, widened by 1.2) far above what any of its nine values sees: a compact bright source
+    // reflections, widened by 1.2), reflected at least by F0, far above what any of its nine values sees:
+    // a compact bright source
     // (the sun) reflected inside the cell could then hide between them. (A source near the cone but
     // outside it reaches the cell through the lobe's tail, smoothly: the values see its gradient; a
     // large light's edge crosses the midlines, where the values differ and the interpolation test splits.)
     bool forced(double x0, double y0, double s, const float (&g)[9][3]) const {
-        if (!lobe.glossy() || s <= tp.kappa * tp.feature) return false;
+        if (!lobe.glossy() || s <= tp.kappa * lobe.alpha) return false;
         auto refl = [&](double X, double Y) {
             const V3 n = t.from_map(X, Y);
             return 2 * dot(n, t.v_) * n - t.v_;
@@ -58,9 +67,10 @@ struct NormalTable::Builder {
         const double radius = std::min(kPi, 1.2 * std::acos(std::clamp(min_cos, -1.0, 1.0)));
         double lo[3], hi[3];
         env.radiance_range(rc, radius, lo, hi);
-        double seen = 0;
+        double seen = 0, hidden = 0;
         for (const auto& v : g) seen = std::max({seen, double(v[0]), double(v[1]), double(v[2])});
-        return std::max({hi[0], hi[1], hi[2]}) > kBrightRatio * (seen + floor_);
+        for (int q = 0; q < 3; ++q) hidden = std::max(hidden, lobe.f0[q] * hi[q]); // at least F0 of it reflects
+        return hidden > kBrightRatio * (seen + floor_);
     }
 
     // Fills tree[slot] for the cell (x0, y0, s) with corner values c00, c10, c01, c11.
@@ -69,8 +79,8 @@ struct NormalTable::Builder {
         float g[9][3];
         for (int q = 0; q < 3; ++q) g[0][q] = c00[q], g[2][q] = c10[q], g[6][q] = c01[q], g[8][q] = c11[q];
         const double h = s / 2;
-        value(x0 + h, y0, g[1]), value(x0, y0 + h, g[3]), value(x0 + h, y0 + h, g[4]);
-        value(x0 + s, y0 + h, g[5]), value(x0 + h, y0 + s, g[7]);
+        value(x0 + h, y0, g[1], h), value(x0, y0 + h, g[3], h), value(x0 + h, y0 + h, g[4], h);
+        value(x0 + s, y0 + h, g[5], h), value(x0 + h, y0 + s, g[7], h);
         // Cells wider than a pixel's footprint (in normal space) must interpolate well pointwise: the
         // largest difference between a test value and the bilinear prediction. Smaller cells only enter
         // pixels through their integral: the difference between the cell's trapezoid (corners) and

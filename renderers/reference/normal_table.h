@@ -30,8 +30,7 @@ struct TableParams {
     double tolerance = 1e-3;   // relative interpolation error that splits a cell
     double floor = 0;          // absolute radiance added to |value| in the tolerance
     int max_depth = 8;         // cells down to coarse / 2^max_depth
-    double kappa = 1;          // forced while the cell is wider than κ·feature
-    double feature = 0;        // the narrowest feature the lobe makes (α; the far part of a split lobe: 4α)
+    double kappa = 1;          // forced while the cell is wider than κ·α
     double min_nv = 0;         // the table covers n·v ≥ min_nv (−0.5 for bump normals)
     double weight_offset = 0;  // errors weigh by clamp(n·v + offset, 0.02, 1) (the image area; bumps: 0.3)
     double footprint = 0;      // a pixel's size in normal space: smaller cells are tested on their integral

@@ -17,10 +17,11 @@
 namespace iblcheck::truth {
 
 // One refinement level. finer() tightens every control (the bound is the difference between a level
-// and its finer one, so the finer one must be finer in every error source).
+// and its finer one, so the finer one must be finer in every error source): tolerances / 4 (the
+// table's / 2), guard / 2.
 struct TruthAccuracy {
     double pixel_tolerance = 1e-3;   // footprint.h, relative per pixel (table and mirror lookups are cheap)
-    double env_tolerance = 2e-3;     // lobe_quadrature.h, relative per shading point (table node)
+    double env_tolerance = 5e-4;     // lobe_quadrature.h, relative per shading point (table node)
     double table_tolerance = 2e-2;   // normal_table.h, the bilinear error that splits a cell (the leaves
                                      // interpolate biquadratically: their error is an order smaller)
     double floor = 1e-3;             // of every tolerance, × the environment's mean radiance
