@@ -7,6 +7,7 @@
 #include <fstream>
 #include <set>
 #include <sstream>
+#include <unistd.h>
 
 #include "harness/common/errors.h"
 #include "metrics/image_io.h"
@@ -28,21 +29,26 @@ std::string run_capture(const std::string& cmd) {
     return out;
 }
 
+// A golden is its image and its sidecar: a golden without a sidecar has lost its provenance and
+// its approved accuracy (the reference band would be silently dropped), and one with NaN/Inf
+// pixels judges nothing. Both are input errors naming the file.
 Golden load_golden(const fs::path& exr, const std::string& label) {
     Golden g;
     g.image_path = exr;
     g.label = label;
     g.image = read_image(exr.string()).pixels;
-    g.provenance = json::object();  // a golden without a sidecar still reads (its provenance is unknown)
+    check_finite(g.image, exr.string());
     fs::path side = fs::path(exr).replace_extension(".json");
-    if (fs::exists(side)) {
-        try {
-            std::ifstream f(side);
-            g.provenance = json::parse(f);
-        } catch (const json::parse_error& e) {
-            throw InputError(side.string() + ": corrupt golden sidecar: " + e.what());
-        }
+    if (!fs::exists(side))
+        throw InputError(side.string() + ": golden sidecar missing (every golden has one; re-create the golden with "
+                                         "iblcheck bless, or scripts/regenerate_reference_goldens.sh for the truth)");
+    try {
+        std::ifstream f(side);
+        g.provenance = json::parse(f);
+    } catch (const json::parse_error& e) {
+        throw InputError(side.string() + ": corrupt golden sidecar: " + e.what());
     }
+    if (!g.provenance.is_object()) throw InputError(side.string() + ": golden sidecar is not a JSON object");
     return g;
 }
 } // namespace
@@ -71,6 +77,11 @@ GoldenStore::GoldenStore(fs::path root) {
         else root = fs::path(IBLCHECK_SOURCE_DIR) / "goldens";
     }
     root_ = root;
+}
+
+std::string GoldenStore::relative(const fs::path& p) const {
+    fs::path r = p.lexically_relative(root_);
+    return r.empty() || *r.begin() == ".." ? p.string() : r.string();
 }
 
 fs::path GoldenStore::baseline_path(const std::string& test_name, const std::string& label) const {
@@ -108,22 +119,43 @@ std::optional<Golden> GoldenStore::reference(const TestSpec& spec) const {
     return load_golden(p, "");
 }
 
-void GoldenStore::write_golden(const fs::path& exr, const cv::Mat& image, const json& provenance) {
-    fs::create_directories(exr.parent_path());
-    std::string tag = ".tmp" + std::to_string(::getpid());
-    fs::path tmp_exr = exr;
-    tmp_exr += tag + ".exr";
-    fs::path side = fs::path(exr).replace_extension(".json");
-    fs::path tmp_side = side;
-    tmp_side += tag;
-    write_exr(tmp_exr.string(), image);
+namespace {
+// Writes `text` to `file` through a temporary file renamed into place.
+void write_atomically(const fs::path& file, const std::string& text) {
+    fs::path tmp = file;
+    tmp += ".tmp" + std::to_string(::getpid());
     {
-        std::ofstream f(tmp_side);
-        f << provenance.dump(2) << "\n";
-        if (!f) throw InputError(tmp_side.string() + ": cannot write golden sidecar");
+        std::ofstream f(tmp);
+        f << text;
+        if (!f) throw InputError(tmp.string() + ": cannot write");
     }
-    fs::rename(tmp_exr, exr);
-    fs::rename(tmp_side, side);
+    std::error_code ec;
+    fs::rename(tmp, file, ec);
+    if (ec) {
+        fs::remove(tmp, ec);
+        throw InputError(file.string() + ": cannot write: " + ec.message());
+    }
+}
+} // namespace
+
+void GoldenStore::write_sidecar(const fs::path& exr, const json& provenance) {
+    write_atomically(fs::path(exr).replace_extension(".json"), provenance.dump(2) + "\n");
+}
+
+void GoldenStore::write_golden(const fs::path& exr, const cv::Mat& image, const json& provenance) {
+    std::error_code ec;
+    fs::create_directories(exr.parent_path(), ec);
+    if (ec) throw InputError(exr.parent_path().string() + ": cannot create the golden folder: " + ec.message());
+    fs::path tmp_exr = exr;
+    tmp_exr += ".tmp" + std::to_string(::getpid()) + ".exr";
+    write_exr(tmp_exr.string(), image);
+    // The sidecar first: a reader that sees the new image always finds its provenance beside it.
+    write_sidecar(exr, provenance);
+    fs::rename(tmp_exr, exr, ec);
+    if (ec) {
+        fs::remove(tmp_exr, ec);
+        throw InputError(exr.string() + ": cannot write: " + ec.message());
+    }
 }
 
 std::string project_commit(bool* dirty) {

@@ -22,7 +22,7 @@ namespace iblcheck {
 struct Golden {
     std::filesystem::path image_path;
     cv::Mat image;               // CV_32FC3 linear
-    nlohmann::json provenance;   // sidecar
+    nlohmann::json provenance = nlohmann::json::object();  // sidecar
     std::string label;           // "" for the primary baseline, else the @label
 };
 
@@ -32,14 +32,20 @@ class GoldenStore {
     explicit GoldenStore(std::filesystem::path root = {});
     const std::filesystem::path& root() const { return root_; }
 
-    // All approved baselines of a test (primary first). Throws InputError on a corrupt golden.
+    // All approved baselines of a test (primary first). Throws InputError naming the file on a
+    // corrupt golden, one with NaN/Inf pixels, or one without its sidecar.
     std::vector<Golden> baselines(const std::string& test_name) const;
     std::optional<Golden> reference(const TestSpec& spec) const;
     std::filesystem::path baseline_path(const std::string& test_name, const std::string& label = "") const;
     std::filesystem::path reference_path(const TestSpec& spec) const;
 
-    // Atomically writes image + sidecar.
+    // Atomically writes image + sidecar (each through a temporary file renamed into place).
+    // Throws InputError naming the path when it cannot.
     static void write_golden(const std::filesystem::path& exr, const cv::Mat& image, const nlohmann::json& provenance);
+    // Atomically rewrites the sidecar of `exr` only (the pixels are unchanged).
+    static void write_sidecar(const std::filesystem::path& exr, const nlohmann::json& provenance);
+    // `p` relative to the golden root (as results and sidecars name goldens), or `p` if outside it.
+    std::string relative(const std::filesystem::path& p) const;
 
   private:
     std::filesystem::path root_;

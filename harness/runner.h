@@ -1,5 +1,6 @@
-// Runs a suite: render → metrics → verdict → results JSON (+ JUnit, images). The runner knows no
-// Vulkan (it calls Renderer) and writes no goldens except through bless().
+// Runs a suite: render → metrics (image_compare.h) → verdict (verdict.h) → results JSON (+ JUnit,
+// report, images). The runner knows no Vulkan (it calls Renderer) and writes no goldens (bless.h
+// does). Stability and temporal checks live in stability.h and temporal_check.h.
 #pragma once
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -7,7 +8,9 @@
 #include <string>
 #include <vector>
 
+#include "bless.h"
 #include "golden_store.h"
+#include "junit.h"
 #include "suite.h"
 
 namespace iblcheck {
@@ -37,23 +40,5 @@ struct RunSummary {
 };
 
 RunSummary run_suite(const RunOptions& options);
-
-struct BlessOptions {
-    std::string suite = "ci";
-    std::string filter;
-    std::string label;                  // "" primary baseline, else an alternate baseline@label
-    std::filesystem::path goldens;
-    std::string device;
-    bool dry_run = false;
-};
-// Re-renders and writes baselines; returns the exit code (2 if any render failed: nothing is
-// written for a failed render).
-int bless(const BlessOptions& options);
-
-// The bless command that approves a test (shown on failure).
-std::string bless_command(const TestCase& t);
-
-// Writes JUnit XML for results (one testcase per test).
-void write_junit(const nlohmann::json& results, const std::filesystem::path& file);
 
 } // namespace iblcheck

@@ -96,7 +96,8 @@ struct Ctx {
 };
 
 StabilitySpec parse_stability(const Ctx& c, const json& j, const std::string& where, StabilitySpec st) {
-    c.keys(j, where, {"repeats", "seeds", "thread_counts", "roughness_bias", "camera_shift", "min_margin", "fail_on_flaky"});
+    c.keys(j, where, {"repeats", "seeds", "thread_counts", "roughness_bias", "camera_shift", "min_margin", "fail_on_flaky",
+                      "cpu_caps"});
     st.enabled = true;
     if (j.contains("repeats")) st.repeats = int(c.num(j["repeats"], where + ".repeats"));
     if (j.contains("seeds")) st.seeds = int(c.num(j["seeds"], where + ".seeds"));
@@ -105,6 +106,18 @@ StabilitySpec parse_stability(const Ctx& c, const json& j, const std::string& wh
     if (j.contains("camera_shift")) st.camera_shift = c.num(j["camera_shift"], where + ".camera_shift");
     if (j.contains("min_margin")) st.min_margin = c.num(j["min_margin"], where + ".min_margin");
     if (j.contains("fail_on_flaky")) st.fail_on_flaky = c.boolean(j["fail_on_flaky"], where + ".fail_on_flaky");
+    if (j.contains("cpu_caps")) {
+        const json& caps = j["cpu_caps"];
+        if (!caps.is_array()) c.fail(where + ".cpu_caps", "must be an array of GALLIUM_OVERRIDE_CPU_CAPS values");
+        st.cpu_caps.clear();
+        for (size_t k = 0; k < caps.size(); ++k) {
+            std::string v = c.str(caps[k], where + ".cpu_caps[" + std::to_string(k) + "]");
+            // The values Mesa 22.3 recognises (u_cpu_detect.c); others are silently ignored by Mesa.
+            static const std::set<std::string> known = {"nosse", "sse", "sse2", "sse3", "ssse3", "sse4.1", "avx"};
+            if (!known.count(v)) c.fail(where + ".cpu_caps[" + std::to_string(k) + "]", "'" + v + "' is not one of nosse, sse, sse2, sse3, ssse3, sse4.1, avx (Mesa ignores other values)");
+            st.cpu_caps.push_back(v);
+        }
+    }
     if (st.repeats < 1 || st.seeds < 1) c.fail(where, "repeats and seeds must be >= 1");
     return st;
 }
@@ -156,11 +169,19 @@ Suite load_suite(const std::string& name_or_path) {
     if (!root.contains("tests")) c.fail("tests", "missing required key");
     Suite suite;
     suite.file = file;
+    // A suite found by name is named again; one given by path is given by its absolute path, so
+    // the bless command printed on failure works from any folder.
+    suite.arg = fs::path(name_or_path).extension() == ".json" ? fs::absolute(file).lexically_normal().string()
+                                                              : name_or_path;
     suite.name = c.str(root["suite"], "suite");
     if (root.contains("description")) suite.description = c.str(root["description"], "description");
 
     json defaults = root.value("defaults", json::object());
-    c.keys(defaults, "defaults", {"env", "size", "jobs", "baseline_tolerances", "reference_band", "stability"});
+    c.keys(defaults, "defaults", {"env", "size", "jobs", "baseline_tolerances", "reference_band", "stability",
+                                  "max_cost_growth"});
+    double default_cost_growth = defaults.contains("max_cost_growth")
+                                     ? c.num(defaults["max_cost_growth"], "defaults.max_cost_growth")
+                                     : 0.25;
     StabilitySpec default_stability;
     if (defaults.contains("stability"))
         default_stability = parse_stability(c, defaults["stability"], "defaults.stability", default_stability);
@@ -181,7 +202,9 @@ Suite load_suite(const std::string& name_or_path) {
         const json& t = root["tests"][i];
         std::string w = "tests[" + std::to_string(i) + "]";
         c.keys(t, w, {"scene", "method", "env", "size", "options", "variants", "baseline", "reference",
-                      "baseline_tolerances", "reference_band", "tags", "temporal", "stability"});
+                      "baseline_tolerances", "reference_band", "tags", "temporal", "stability", "max_cost_growth",
+                      "tolerance_note"});
+        if (t.contains("tolerance_note")) c.str(t["tolerance_note"], w + ".tolerance_note");
         if (!t.contains("scene")) c.fail(w + ".scene", "missing required key");
         if (!t.contains("method")) c.fail(w + ".method", "missing required key");
         std::vector<std::string> envs;
@@ -200,6 +223,10 @@ Suite load_suite(const std::string& name_or_path) {
         }
         TestCase proto;
         proto.suite = suite.name;
+        proto.suite_arg = suite.arg;
+        proto.max_cost_growth = t.contains("max_cost_growth") ? c.num(t["max_cost_growth"], w + ".max_cost_growth")
+                                                              : default_cost_growth;
+        if (!(proto.max_cost_growth >= 0)) c.fail(w + ".max_cost_growth", "must be >= 0");
         proto.spec.scene = c.str(t["scene"], w + ".scene");
         proto.spec.method = c.str(t["method"], w + ".method");
         proto.spec.width = dw;

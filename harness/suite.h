@@ -6,23 +6,27 @@
 // Schema (keys marked * are required):
 // {
 //   "suite"*: "ci",  "description": "...",
-//   "defaults": { "env": "studio", "size": "WxH", "jobs": 2,
+//   "defaults": { "env": "studio", "size": "WxH", "jobs": 2, "max_cost_growth": 0.25,
 //                 "baseline_tolerances": { METRIC: {"min": x, "max": y}, ... },
 //                 "reference_band": { METRIC: {"below": rel, "above": rel, "abs": a}, ... } },
 //   "tests"*: [ { "scene"*: "roughness_sweep", "method"*: "mobile",
 //                "env": "studio" | ["studio", "sky_sun"], "size": "WxH",
 //                "options": {k: v}, "variants": [{k: v}, ...],
 //                "baseline": true, "reference": true,
-//                "baseline_tolerances": {...}, "reference_band": {...}, "tags": ["..."],
+//                "baseline_tolerances": {...}, "reference_band": {...}, "max_cost_growth": 0.25, "tags": ["..."],
+//                "tolerance_note": "why this test's tolerances differ from the defaults (measured floors)",
 //                "temporal": {"frames": 32, "reference_ssaa": 8, "checks": {NAME: {"min": x, "max": y}}},
 //                "stability": {"repeats": 2, "seeds": 3, "thread_counts": true, "min_margin": 3,
-//                              "fail_on_flaky": false} } ]       ("stability" may also sit in "defaults")
+//                              "fail_on_flaky": false, "cpu_caps": ["avx", "sse4.1"]} } ]
+//                                                 ("stability" may also sit in "defaults")
 // }
 // METRIC is one of flip.mean, flip.p99, flip.block_max, ssim.mean, psnr.db; in a test, METRIC: null
 // drops a suite default (e.g. a percentile that seed noise alone saturates).
 // baseline_tolerances bound the difference to the approved baseline (deterministic renders: tight).
 // reference_band bounds the accuracy against the ground truth around the value approved at bless
 // time: [v·(1 − below) − abs, v·(1 + above) + abs]; under the band is `improved`, over it `fail`.
+// max_cost_growth bounds the growth of the render's deterministic cost per pixel (executed SPIR-V
+// instructions, texture fetches) over the cost recorded with the baseline (0.25: +25 %).
 #pragma once
 #include <filesystem>
 #include <map>
@@ -30,16 +34,11 @@
 #include <string>
 #include <vector>
 
+#include "harness/verdict.h"
 #include "renderers/render_api.h"
 
 namespace iblcheck {
 
-struct Bound {
-    std::optional<double> min, max;
-};
-struct Band {
-    double below = 0.1, above = 0.1, abs = 0.0;
-};
 
 // Temporal tests (animated scenes): every frame of the test, of the same scene with
 // specular_aa=off (the comparison) and of the reference sequence (the same shading, ssaa ×
@@ -63,17 +62,22 @@ struct StabilitySpec {
     double camera_shift = 0.25;   // pixels
     double min_margin = 3.0;
     bool fail_on_flaky = false;
+    // Cross-CPU noise floor: each render again with GALLIUM_OVERRIDE_CPU_CAPS=<caps> (llvmpipe then
+    // generates code for that lesser CPU, as on another CI runner), in a child process.
+    std::vector<std::string> cpu_caps = {"avx", "sse4.1"};
 };
 
 struct TestCase {
     std::string name;
     std::string suite;
+    std::string suite_arg;           // what `--suite` needs to find the suite again: its name, or its path
     std::string variant;             // "default" or the canonical k=v list of all the test's options
     TestSpec spec;
     bool baseline = true;            // compare with approved baselines
     bool reference = true;           // measure accuracy against the reference golden if one exists
     std::map<std::string, Bound> baseline_tolerances;
     std::map<std::string, Band> reference_band;
+    double max_cost_growth = 0.25;   // cost per pixel (SPIR-V instructions, texture fetches) vs the baseline's
     std::vector<std::string> tags;
     TemporalSpec temporal;
     StabilitySpec stability;
@@ -83,6 +87,7 @@ struct Suite {
     std::string name;
     std::string description;
     std::filesystem::path file;
+    std::string arg;                 // the suite's name, or the absolute path it was loaded from
     int jobs = 2;
     std::vector<TestCase> tests;
 };

@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <cstring>
 #include <stdexcept>
 #include <vector>
@@ -305,6 +306,20 @@ flip::ExposureRange flip_auto_exposure_range(const cv::Mat& ref_linear, flip::To
     return flip::auto_exposure_range(tm, std::move(lum));
 }
 
+namespace {
+// The tool's exposure rule over the pixels with positive luminance only.
+flip::ExposureRange lit_exposure_range(const cv::Mat& linear, flip::ToneMapper tm) {
+    std::vector<float> lum;
+    for (int y = 0; y < linear.rows; ++y) {
+        const float* p = linear.ptr<float>(y);
+        for (int x = 0; x < linear.cols; ++x, p += 3)
+            if (float l = 0.2126f * p[0] + 0.7152f * p[1] + 0.0722f * p[2]; l > 0) lum.push_back(l);
+    }
+    if (lum.empty()) return {std::numeric_limits<float>::infinity(), std::numeric_limits<float>::infinity()};
+    return flip::auto_exposure_range(tm, std::move(lum));
+}
+} // namespace
+
 FlipResult compute_flip_ldr(const cv::Mat& ref_srgb, const cv::Mat& test_srgb, const FlipOptions& opts) {
     check_pair(ref_srgb, test_srgb, "FLIP");
     const int w = ref_srgb.cols, h = ref_srgb.rows;
@@ -338,8 +353,28 @@ FlipResult compute_flip_hdr(const cv::Mat& ref_linear, const cv::Mat& test_linea
     r.ppd = ppd;
 
     float start, stop;
+    r.exposure_source = "given";
     if (!opts.start_exposure || !opts.stop_exposure) {
-        const ExposureRange er = flip_auto_exposure_range(ref_linear, opts.tone_mapper);
+        // The tool takes the range from the reference's luminance (max and median). A black
+        // reference has neither: the tool then gets infinite exposures and scores any test 0 (a
+        // silent pass). Take the range from the test instead and say so; if both are black they are
+        // equal and every exposure gives 0, so any finite range is right.
+        // A reference lit in less than half its pixels has a black median (stop = +inf): its
+        // median is then taken over the lit pixels.
+        ExposureRange er = flip_auto_exposure_range(ref_linear, opts.tone_mapper);
+        r.exposure_source = "reference";
+        if (std::isfinite(er.start) && !std::isfinite(er.stop)) {
+            er = lit_exposure_range(ref_linear, opts.tone_mapper);
+            r.exposure_source = "reference (median of its lit pixels)";
+        }
+        if (!std::isfinite(er.start) || !std::isfinite(er.stop)) {
+            er = lit_exposure_range(test_linear, opts.tone_mapper);
+            r.exposure_source = "test (the reference is black)";
+        }
+        if (!std::isfinite(er.start) || !std::isfinite(er.stop)) {
+            er = {0.0f, 0.0f};
+            r.exposure_source = "none (both images are black)";
+        }
         start = opts.start_exposure.value_or(er.start);
         stop = opts.stop_exposure.value_or(er.stop);
     } else {

@@ -44,6 +44,8 @@ struct FlipResult {
     double ppd = 0;
     double start_exposure = 0, stop_exposure = 0; // HDR only
     int num_exposures = 0;                        // HDR only (0 for LDR)
+    std::string exposure_source;                  // HDR: "reference" (the tool's rule), "test (the
+                                                  // reference is black)", "none (...)" or "given"
 };
 
 // LDR-FLIP. Inputs: CV_32FC3, RGB order, sRGB-encoded values in [0,1] (values outside are

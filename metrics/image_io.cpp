@@ -27,7 +27,11 @@ LoadedImage read_image(const std::string& path) {
         throw InputError(fmt::format("{}: file not found", path));
     if (std::filesystem::is_directory(path, ec))
         throw InputError(fmt::format("{}: is a directory, not an image", path));
-    auto in = OIIO::ImageInput::open(path);
+    // OpenImageIO premultiplies colour by alpha on read unless told the file's alpha is
+    // unassociated, which PNG's is by definition: read the colour as stored.
+    OIIO::ImageSpec config;
+    config.attribute("oiio:UnassociatedAlpha", 1);
+    auto in = OIIO::ImageInput::open(path, &config);
     if (!in) {
         std::string why = OIIO::geterror();
         throw InputError(fmt::format("{}: cannot read image ({})", path,
@@ -120,23 +124,28 @@ void write_png(const std::string& path, const cv::Mat& mat) {
     write_with_oiio(path, mat, OIIO::TypeDesc::UINT8, bytes.data());
 }
 
-void check_finite(const cv::Mat& mat, const std::string& path) {
+NonFinite find_non_finite(const cv::Mat& mat) {
     CV_Assert(mat.depth() == CV_32F);
-    size_t count = 0;
-    int fx = -1, fy = -1;
+    NonFinite nf;
     const int nch = mat.channels();
     for (int y = 0; y < mat.rows; ++y) {
         const float* p = mat.ptr<float>(y);
         for (int x = 0; x < mat.cols * nch; ++x) {
             if (!std::isfinite(p[x])) {
-                if (count == 0) fx = x / nch, fy = y;
-                ++count;
+                if (nf.count == 0) nf.x = x / nch, nf.y = y;
+                ++nf.count;
             }
         }
     }
-    if (count)
-        throw InputError(fmt::format("{}: {} non-finite value(s) (NaN/Inf), first at x={}, y={}",
-                                     path, count, fx, fy));
+    return nf;
+}
+
+std::string NonFinite::describe() const {
+    return fmt::format("{} non-finite value(s) (NaN/Inf), first at x={}, y={}", count, x, y);
+}
+
+void check_finite(const cv::Mat& mat, const std::string& path) {
+    if (NonFinite nf = find_non_finite(mat); nf.count) throw InputError(path + ": " + nf.describe());
 }
 
 size_t count_negative(const cv::Mat& mat) {

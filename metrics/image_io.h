@@ -13,11 +13,13 @@ struct LoadedImage {
     cv::Mat pixels;         // CV_32FC3, RGB
     bool hdr = false;       // true: linear float data (EXR/HDR/float TIFF); false: sRGB in [0,1]
     int file_channels = 0;  // channels in the file before dropping alpha / expanding grey
+    bool has_alpha() const { return file_channels == 2 || file_channels == 4; }
     std::string path;
 };
 
 // Reads an image; grey becomes 3 equal channels, alpha (4th channel, or 2nd of grey+alpha) is
-// dropped. Throws InputError: missing file, unreadable/corrupt data, unsupported channel count.
+// dropped after reading the colour unassociated (as stored: not multiplied by alpha, which is
+// what NVIDIA's FLIP tool scores). Throws InputError: missing file, unreadable/corrupt data, unsupported channel count.
 LoadedImage read_image(const std::string& path);
 
 // Writes float data as EXR (half is not used: float keeps error maps exact). 1 or 3 channels.
@@ -25,6 +27,13 @@ void write_exr(const std::string& path, const cv::Mat& mat);
 // Writes 8-bit PNG from float values in [0,1] (clamped, rounded), 1 or 3 channels, RGB order.
 void write_png(const std::string& path, const cv::Mat& mat);
 
+// NaN/Inf values of a float image: how many, and the first pixel (row-major) holding one.
+struct NonFinite {
+    size_t count = 0;
+    int x = -1, y = -1;
+    std::string describe() const; // "N non-finite value(s) (NaN/Inf), first at x=X, y=Y"
+};
+NonFinite find_non_finite(const cv::Mat& mat);
 // NaN/Inf check: throws InputError "<path>: N non-finite value(s) (NaN/Inf), first at x=X, y=Y".
 void check_finite(const cv::Mat& mat, const std::string& path);
 // Number of negative channel values (HDR radiance must be >= 0).

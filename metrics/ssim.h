@@ -10,6 +10,10 @@
 
 namespace iblcheck {
 
+// The Gaussian window's size: smaller images have no SSIM (the metric is not applicable).
+inline constexpr int kSsimMinSize = 11;
+inline bool ssim_applicable(const cv::Mat& m) { return m.cols >= kSsimMinSize && m.rows >= kSsimMinSize; }
+
 struct SsimResult {
     double mean = 0;              // mean over channels of the per-channel mean SSIM
     double per_channel[3] = {0, 0, 0};

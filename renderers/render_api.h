@@ -1,4 +1,4 @@
-// One interface, three methods (DESIGN.md): render(TestSpec) -> RenderResult.
+// One interface, three methods (docs/DESIGN.md): render(TestSpec) -> RenderResult.
 // A renderer knows nothing of metrics; the harness knows nothing of Vulkan.
 #pragma once
 #include <nlohmann/json.hpp>
@@ -31,6 +31,10 @@ struct RenderResult {
     std::vector<PassTiming> timings;
     nlohmann::json provenance;        // method, driver, shader hash, samples, seeds, ...
     double texture_fetches_per_pixel = 0; // driver-independent cost estimate
+    // Dynamic SPIR-V instructions the frame's shading dispatch executed per image pixel, every ssaa
+    // ray included (renderers/vulkan/spirv_cost.h): deterministic, unlike the timings. 0 for the
+    // CPU reference and on a device that cannot count.
+    double shader_instructions_per_pixel = 0;
 };
 
 } // namespace iblcheck

@@ -50,6 +50,8 @@ std::vector<OptionInfo> option_catalog() {
         {"storage", "rgba16f", "rgba16f|rgba32f|rgbm8|r11g11b10", "mobile", "prefiltered cube storage"},
         {"rgbm_range", "6", ">0", "mobile", "RGBM range (storage=rgbm8)"},
         {"precision", "highp", "highp|mediump", "mobile", "mediump shades in float16_t"},
+        {"fp16", "auto", "auto|native|emulated", "mobile",
+         "precision=mediump: native float16_t, or emulated (fp32 rounded to fp16 per operation); auto: native if shaderFloat16"},
         {"specular_aa", "off", "off|tokuyoshi|rjump|toksvig", "mobile", "specular anti-aliasing for low roughness"},
         {"specular_aa_variance", "0.25", ">=0", "mobile", "specular AA: screen-space variance scale"},
         {"specular_aa_threshold", "0.18", ">=0", "mobile", "specular AA: clamp of the added roughness"},

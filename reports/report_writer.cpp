@@ -394,8 +394,8 @@ void test_card(std::string& o, const json& t, size_t idx, ImageStore& store, con
     }
     if (!str(t, "message").empty()) fmt::format_to(out, "<div class=\"message\">{}</div>\n", e(str(t, "message")));
     if (!str(t, "driver_mismatch").empty())
-        fmt::format_to(out, "<div class=\"warn\">&#9888; driver mismatch: {} &mdash; differences may come from the "
-                            "driver, not the shader.</div>\n",
+        fmt::format_to(out, "<div class=\"warn\">&#9888; {} &mdash; differences may come from the platform (driver or "
+                            "the CPU llvmpipe generates code for), not the shader.</div>\n",
                        e(str(t, "driver_mismatch")));
     if (needs_bless(v) && !str(t, "bless_command").empty())
         fmt::format_to(out,

@@ -10,6 +10,7 @@
 #include <set>
 #include <sys/wait.h>
 
+#include "tests/test_support.h"
 #include "harness/common/errors.h"
 #include "harness/golden_store.h"
 #include "harness/runner.h"
@@ -21,26 +22,10 @@ using nlohmann::json;
 
 namespace {
 
-fs::path temp_dir(const std::string& name) {
-    fs::path p = fs::temp_directory_path() / ("iblcheck_harness_" + name + "_" + std::to_string(::getpid()));
-    fs::remove_all(p);
-    fs::create_directories(p);
-    return p;
-}
+using namespace iblcheck::testutil;
 
-void write_file(const fs::path& p, const std::string& text) {
-    fs::create_directories(p.parent_path());
-    std::ofstream(p) << text;
-}
 
-int run_command(const std::string& cmd, std::string& out) {
-    FILE* pipe = popen((cmd + " 2>&1").c_str(), "r");
-    std::array<char, 512> buf;
-    out.clear();
-    while (fgets(buf.data(), buf.size(), pipe)) out += buf.data();
-    int status = pclose(pipe);
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
+
 
 std::string iblcheck_bin() { return std::string(IBLCHECK_BINARY_DIR) + "/iblcheck"; }
 
@@ -134,7 +119,8 @@ TEST(Harness, MissingGoldenThenBlessThenPassThenImproved) {
     EXPECT_EQ(s1.missing, 2);
     EXPECT_EQ(s1.exit_code(), kExitRegression);
     std::string msg = s1.results["tests"][0]["message"];
-    EXPECT_NE(msg.find("iblcheck bless --suite mini --filter 'mobile.furnace.constant:1.default'"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("iblcheck bless --suite '" + o.suite + "' --filter 'mobile.furnace.constant:1.default'"),
+              std::string::npos) << msg;
 
     BlessOptions b;
     b.suite = o.suite;
@@ -144,8 +130,8 @@ TEST(Harness, MissingGoldenThenBlessThenPassThenImproved) {
     ASSERT_TRUE(fs::exists(golden));
     std::ifstream side(fs::path(golden).replace_extension(".json"));
     json prov = json::parse(side);
-    for (const char* key : {"scene", "options", "shader_tree_hash", "driver", "cpu_features", "commit", "date", "command",
-                            "env_hash", "accuracy"})
+    for (const char* key : {"scene", "options", "shader_tree_hash", "driver", "cpu_features", "cpu_class", "commit", "date",
+                            "command", "env_hash", "accuracy", "cost"})
         EXPECT_TRUE(prov.contains(key)) << key;
     EXPECT_EQ(prov["driver"]["driver"], "llvmpipe");
     EXPECT_TRUE(prov["accuracy"].contains("flip.mean"));
@@ -168,7 +154,9 @@ TEST(Harness, MissingGoldenThenBlessThenPassThenImproved) {
     EXPECT_EQ(s3.improved, 1);
     EXPECT_EQ(s3.exit_code(), kExitPass);
     for (auto& t : s3.results["tests"])
-        if (t["verdict"] == "improved") EXPECT_NE(t["message"].get<std::string>().find("tighten"), std::string::npos);
+        if (t["verdict"] == "improved") {
+            EXPECT_NE(t["message"].get<std::string>().find("tighten"), std::string::npos);
+        }
 
     // A second approved baseline (@label) is accepted when the primary no longer matches.
     cv::Mat img = GoldenStore(goldens).baselines("mobile.furnace.constant:1.default")[0].image.clone();
@@ -235,7 +223,9 @@ TEST(Gate, ShaderChangeFailsExactlyTheAffectedCiTestsAndBisectFollowsTheContract
         bool approx = t["method"] == "mobile" && name.find("env_brdf=lut") == std::string::npos;
         EXPECT_EQ(t["verdict"], approx ? "fail" : "pass") << name << ": " << t["message"];
         failed += t["verdict"] == "fail";
-        if (approx) EXPECT_NE(t["message"].get<std::string>().find("worst 16x16 block at"), std::string::npos);
+        if (approx) {
+            EXPECT_NE(t["message"].get<std::string>().find("worst 16x16 block at"), std::string::npos);
+        }
     }
     EXPECT_GE(failed, 20);
 

@@ -3,6 +3,7 @@
 // threading determinism and `iblcheck compare` behaviour on good and bad input.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -11,6 +12,7 @@
 #include <sstream>
 
 #include <CLI/CLI.hpp>
+#include <OpenImageIO/imageio.h>
 #include <nlohmann/json.hpp>
 
 #include "harness/cli/compare_command.h"
@@ -396,3 +398,97 @@ TEST_F(CompareCommand, IdenticalImagesPerfectScores) {
 }
 
 } // namespace
+
+// Writes an 8-bit RGBA PNG (OpenImageIO, unassociated alpha as PNG stores it).
+static void write_rgba_png(const std::string& file, const cv::Mat& rgb, float alpha) {
+    std::vector<unsigned char> px(size_t(rgb.total()) * 4);
+    for (int y = 0, i = 0; y < rgb.rows; ++y)
+        for (int x = 0; x < rgb.cols; ++x, i += 4) {
+            const cv::Vec3f c = rgb.at<cv::Vec3f>(y, x);
+            for (int k = 0; k < 3; ++k) px[size_t(i + k)] = (unsigned char)(std::clamp(c[k], 0.0f, 1.0f) * 255.0f + 0.5f);
+            px[size_t(i + 3)] = (unsigned char)(alpha * 255.0f + 0.5f);
+        }
+    auto out = OIIO::ImageOutput::create(file);
+    OIIO::ImageSpec spec(rgb.cols, rgb.rows, 4, OIIO::TypeDesc::UINT8);
+    spec.attribute("oiio:UnassociatedAlpha", 1);
+    ASSERT_TRUE(out && out->open(file, spec) && out->write_image(OIIO::TypeDesc::UINT8, px.data()));
+    out->close();
+}
+
+TEST_F(CompareCommand, RgbaPngColourIsReadAsStoredNotPremultiplied) {
+    // Issue 14: OpenImageIO premultiplied colour by alpha, so an RGBA pair scored FLIP 0.188 where
+    // NVIDIA's tool (which scores the stored colour) gives 0.0155. The colour of an RGBA PNG now
+    // reads exactly as stored, so an RGBA pair scores what the same colours score as RGB.
+    const cv::Mat a = synthetic(64, 48, 7, 0.02f), b = synthetic(64, 48, 8, 0.05f);
+    write_rgba_png(path("a.png"), a, 0.25f);
+    write_rgba_png(path("b.png"), b, 0.25f);
+    write_png(path("a_rgb.png"), a);
+    write_png(path("b_rgb.png"), b);
+    const LoadedImage la = read_image(path("a.png")), la_rgb = read_image(path("a_rgb.png"));
+    EXPECT_EQ(la.file_channels, 4);
+    EXPECT_TRUE(la.has_alpha());
+    EXPECT_EQ(cv::norm(la.pixels, la_rgb.pixels, cv::NORM_INF), 0.0);  // not scaled by 0.25
+    CompareArgs c = args(path("a.png"), path("b.png"));
+    c.json = true;
+    ASSERT_EQ(run(c), 0) << err_.str();
+    const double rgba = nlohmann::json::parse(out_.str())["flip"]["mean"];
+    c = args(path("a_rgb.png"), path("b_rgb.png"));
+    c.json = true;
+    ASSERT_EQ(run(c), 0) << err_.str();
+    EXPECT_EQ(rgba, nlohmann::json::parse(out_.str())["flip"]["mean"].get<double>());
+    // RGB against RGBA is refused, naming both files (alpha would be silently ignored on one side).
+    EXPECT_EQ(run(args(path("a_rgb.png"), path("b.png"))), kExitError);
+    EXPECT_NE(err_.str().find(path("b.png") + ": has 4 channel(s) but " + path("a_rgb.png") + " has 3"), std::string::npos)
+        << err_.str();
+}
+
+TEST_F(CompareCommand, BlackHdrReferenceTakesExposuresFromTheTestAndSaysSo) {
+    // Issue 14: with an all-black reference the tool's exposure range is infinite and every test
+    // scored 0 (a white test passed). The range now comes from the test image, and the output says so.
+    cv::Mat black(32, 32, CV_32FC3, cv::Scalar(0, 0, 0)), white(32, 32, CV_32FC3, cv::Scalar(1, 1, 1));
+    write_exr(path("black.exr"), black);
+    write_exr(path("white.exr"), white);
+    CompareArgs c = args(path("black.exr"), path("white.exr"));
+    c.json = true;
+    ASSERT_EQ(run(c), 0) << err_.str();
+    auto j = nlohmann::json::parse(out_.str());
+    EXPECT_GT(j["flip"]["mean"].get<double>(), 0.5);
+    EXPECT_EQ(j["flip"]["exposure_source"], "test (the reference is black)");
+    EXPECT_TRUE(std::isfinite(j["flip"]["start_exposure"].get<double>()));
+    // Both black: identical images, FLIP 0 with a finite range.
+    c = args(path("black.exr"), path("black.exr"));
+    c.json = true;
+    ASSERT_EQ(run(c), 0) << err_.str();
+    j = nlohmann::json::parse(out_.str());
+    EXPECT_EQ(j["flip"]["mean"].get<double>(), 0.0);
+    EXPECT_EQ(j["flip"]["exposure_source"], "none (both images are black)");
+    // A reference lit in under half its pixels (black median): the median of the lit pixels.
+    cv::Mat spot = black.clone();
+    spot(cv::Rect(0, 0, 8, 8)).setTo(cv::Scalar(2, 2, 2));
+    write_exr(path("spot.exr"), spot);
+    c = args(path("spot.exr"), path("white.exr"));
+    c.json = true;
+    ASSERT_EQ(run(c), 0) << err_.str();
+    j = nlohmann::json::parse(out_.str());
+    EXPECT_EQ(j["flip"]["exposure_source"], "reference (median of its lit pixels)");
+    EXPECT_TRUE(std::isfinite(j["flip"]["stop_exposure"].get<double>()));
+    EXPECT_GT(j["flip"]["mean"].get<double>(), 0.3);
+}
+
+TEST_F(CompareCommand, ImagesUnderSsimsWindowGetFlipAndPsnrAndSsimNotApplicable) {
+    // Issue 14: an 8x8 pair exited 2 ("SSIM: images must be at least 11x11", no file named) and
+    // withheld FLIP. Now FLIP and PSNR are reported and SSIM is marked not applicable.
+    write_png(path("a.png"), synthetic(8, 8, 1, 0.0f));
+    write_png(path("b.png"), synthetic(8, 8, 2, 0.1f));
+    CompareArgs c = args(path("a.png"), path("b.png"));
+    c.json = true;
+    ASSERT_EQ(run(c), 0) << err_.str();
+    auto j = nlohmann::json::parse(out_.str());
+    EXPECT_GT(j["flip"]["mean"].get<double>(), 0.0);
+    EXPECT_GT(j["psnr"]["db"].get<double>(), 0.0);
+    EXPECT_TRUE(j["ssim"]["mean"].is_null());
+    EXPECT_NE(j["ssim"]["not_applicable"].get<std::string>().find("11x11"), std::string::npos);
+    c.json = false;
+    ASSERT_EQ(run(c), 0) << err_.str();
+    EXPECT_NE(out_.str().find("SSIM not applicable"), std::string::npos) << out_.str();
+}

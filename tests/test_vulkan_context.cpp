@@ -10,34 +10,21 @@
 #include <fstream>
 #include <sys/wait.h>
 
+#include "tests/test_support.h"
 #include "harness/common/errors.h"
 #include "renderers/vulkan/context.h"
+#include "renderers/vulkan/fp16_emulation.h"
 
 namespace fs = std::filesystem;
 using namespace iblcheck;
 
 namespace {
 
-fs::path temp_dir(const std::string& name) {
-    fs::path p = fs::temp_directory_path() / ("iblcheck_test_" + name + "_" + std::to_string(::getpid()));
-    fs::create_directories(p);
-    return p;
-}
+using namespace iblcheck::testutil;
 
-void write_file(const fs::path& p, const std::string& text) {
-    std::ofstream f(p);
-    f << text;
-}
+
 
 // Runs a shell command, returns its exit status and output (stdout + stderr).
-int run_command(const std::string& cmd, std::string& output) {
-    FILE* pipe = popen((cmd + " 2>&1").c_str(), "r");
-    std::array<char, 512> buf;
-    output.clear();
-    while (fgets(buf.data(), buf.size(), pipe)) output += buf.data();
-    int status = pclose(pipe);
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
 
 std::vector<float> run_shader(vk::Context& ctx, const vk::CompiledShader& shader, uint32_t n) {
     vk::Buffer buf = ctx.create_buffer(n * 4);
@@ -160,6 +147,28 @@ TEST(Doctor, NamesLlvmpipeAndExitsZero) {
     EXPECT_EQ(rc, 0) << out;
     EXPECT_NE(out.find("llvmpipe"), std::string::npos) << out;
     EXPECT_NE(out.find("shaderFloat16:   yes"), std::string::npos) << out;
+}
+
+TEST(Doctor, StatesTheFp16DecisionTheRendererMakes) {
+    // The line comes from choose_fp16_path, the renderer's rule: native here, emulated when
+    // llvmpipe targets a CPU without AVX (no F16C, no shaderFloat16). Before issue 15 doctor
+    // claimed an fp32 fallback while the renderer refused the variant.
+    vk::Context ctx({"", false});
+    std::string expected = "precision=mediump: " + vk::fp16_path_description(vk::choose_fp16_path(
+                                                       "auto", ctx.info().shader_float16, ctx.info().device_name));
+    std::string out;
+    EXPECT_EQ(run_command(std::string(IBLCHECK_BINARY_DIR) + "/iblcheck doctor", out), 0) << out;
+    EXPECT_NE(out.find(expected + "\n"), std::string::npos) << out;
+    EXPECT_NE(out.find("precision=mediump: native float16_t\n"), std::string::npos) << out;
+    EXPECT_NE(out.find("llvmpipe cpu:    "), std::string::npos) << out;
+    EXPECT_EQ(run_command("GALLIUM_OVERRIDE_CPU_CAPS=sse4.1 " + std::string(IBLCHECK_BINARY_DIR) + "/iblcheck doctor", out),
+              0)
+        << out;
+    EXPECT_NE(out.find("shaderFloat16:   no\n"), std::string::npos) << out;
+    EXPECT_NE(out.find("precision=mediump: " + vk::fp16_path_description(vk::Fp16Path::emulated) + "\n"),
+              std::string::npos)
+        << out;
+    EXPECT_NE(out.find("cpu override:    GALLIUM_OVERRIDE_CPU_CAPS=sse4.1"), std::string::npos) << out;
 }
 
 TEST(Doctor, WithoutDriverExitsTwoWithAFix) {

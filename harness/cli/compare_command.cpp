@@ -46,9 +46,10 @@ int run_compare(const CompareArgs& a, std::ostream& out, std::ostream& err) {
         LoadedImage ref = read_image(a.reference);
         LoadedImage test = read_image(a.test);
         check_same_size(ref.pixels, test.pixels, a.reference, a.test);
-        // Grey vs colour, or colour vs colour+alpha, is a different kind of image: refuse.
+        // Grey vs colour, or an image with alpha vs one without, is a different kind of image:
+        // refuse. (Alpha itself is not scored: both files' colour is read as stored.)
         const int ch_ref = ref.file_channels <= 2 ? 1 : 3, ch_test = test.file_channels <= 2 ? 1 : 3;
-        if (ch_ref != ch_test)
+        if (ch_ref != ch_test || ref.has_alpha() != test.has_alpha())
             throw InputError(fmt::format("{}: has {} channel(s) but {} has {}", a.test,
                                          test.file_channels, a.reference, ref.file_channels));
         if (ref.hdr != test.hdr)
@@ -102,12 +103,17 @@ int run_compare(const CompareArgs& a, std::ostream& out, std::ostream& err) {
                 f["stop_exposure"] = fr.stop_exposure;
                 f["num_exposures"] = fr.num_exposures;
                 f["tone_mapper"] = flip::tone_mapper_name(tm);
+                f["exposure_source"] = fr.exposure_source;
             }
             j["flip"] = f;
             if (!a.heatmap.empty()) write_png(a.heatmap, magma_heatmap(fr.errmap));
             if (!a.errmap.empty()) write_exr(a.errmap, fr.errmap);
         }
-        if (want_ssim) {
+        if (want_ssim && !ssim_applicable(ref.pixels)) {
+            j["ssim"] = {{"mean", nullptr},
+                         {"not_applicable", fmt::format("{}x{} is smaller than SSIM's {}x{} window", ref.pixels.cols,
+                                                        ref.pixels.rows, kSsimMinSize, kSsimMinSize)}};
+        } else if (want_ssim) {
             const SsimResult s = hdr ? compute_ssim_hdr(ref.pixels, test.pixels)
                                      : compute_ssim(ref.pixels, test.pixels);
             j["ssim"] = {{"mean", s.mean}};
@@ -134,11 +140,14 @@ int run_compare(const CompareArgs& a, std::ostream& out, std::ostream& err) {
                 out << fmt::format("FLIP worst 16x16 block: mean {:.6f} at x={}, y={}\n", fr.block_max,
                                    fr.block_x, fr.block_y);
                 if (hdr)
-                    out << fmt::format("HDR-FLIP exposures: {:.4f} to {:.4f}, {} exposures ({})\n",
+                    out << fmt::format("HDR-FLIP exposures: {:.4f} to {:.4f}, {} exposures ({}), range from {}\n",
                                        fr.start_exposure, fr.stop_exposure, fr.num_exposures,
-                                       flip::tone_mapper_name(tm));
+                                       flip::tone_mapper_name(tm), fr.exposure_source);
             }
-            if (want_ssim) out << fmt::format("SSIM {:.6f}\n", j["ssim"]["mean"].get<double>());
+            if (want_ssim)
+                out << (j["ssim"]["mean"].is_null()
+                            ? "SSIM not applicable: " + j["ssim"]["not_applicable"].get<std::string>() + "\n"
+                            : fmt::format("SSIM {:.6f}\n", j["ssim"]["mean"].get<double>()));
             if (want_psnr) {
                 const auto& p = j["psnr"];
                 out << fmt::format("PSNR {} dB  RMSE {:.6f}  max |diff| {:.6f}\n",

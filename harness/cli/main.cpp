@@ -1,5 +1,5 @@
 // iblcheck: image-diff validation harness for mobile IBL shaders.
-// Exit codes (DESIGN.md): 0 pass, 1 regression, 2 usage/input/environment error,
+// Exit codes (docs/DESIGN.md): 0 pass, 1 regression, 2 usage/input/environment error,
 // 125 (bisect only) cannot test this commit.
 #include <CLI/CLI.hpp>
 #include <fmt/core.h>

@@ -78,6 +78,9 @@ void register_render_command(CLI::App& app, int& exit_code) {
         }
         fmt::print(human, "{:<20} {:9.3f} ms\n", "total", total);
         fmt::print(human, "texture samples/px  {:.2f}\n", r.texture_fetches_per_pixel);
+        // The deterministic cost (issue 14): the same on every run, where the times above are not.
+        if (r.shader_instructions_per_pixel > 0)
+            fmt::print(human, "spirv instr/px      {:.2f}\n", r.shader_instructions_per_pixel);
         if (!out.empty()) {
             write_exr(out, r.image);
             write_png(png.string(), display_transform(r.image));
@@ -87,6 +90,7 @@ void register_render_command(CLI::App& app, int& exit_code) {
             nlohmann::json j;
             j["provenance"] = r.provenance;
             j["texture_fetches_per_pixel"] = r.texture_fetches_per_pixel;
+            j["shader_instructions_per_pixel"] = r.shader_instructions_per_pixel;
             for (auto& t : r.timings)
                 j["timings"].push_back({{"pass", t.name}, {"ms", t.ms}, {"gpu", t.gpu}, {"precompute", t.precompute}});
             if (json_out == "-") {
@@ -96,6 +100,20 @@ void register_render_command(CLI::App& app, int& exit_code) {
                 if (!f) throw InputError(json_out + ": cannot write");
                 f << j.dump(2) << "\n";
             }
+        }
+        // Non-finite pixels are the shader's fault: a regression (exit 1), after the files are
+        // written so the pixels can be inspected.
+        if (NonFinite nf = find_non_finite(r.image); nf.count) {
+            fmt::print(stderr, "error: {} {} under {}: the render has {}\n", method, scene, env, nf.describe());
+            exit_code = kExitRegression;
+            return;
+        }
+        // Non-finite pixels are the shader's fault: a regression (exit 1), after the files are
+        // written so the pixels can be inspected.
+        if (NonFinite nf = find_non_finite(r.image); nf.count) {
+            fmt::print(stderr, "error: {} {} under {}: the render has {}\n", method, scene, env, nf.describe());
+            exit_code = kExitRegression;
+            return;
         }
         exit_code = kExitPass;
     });

@@ -30,7 +30,7 @@ void register_run_commands(CLI::App& app, int& exit_code) {
     r->add_option("--history", history, "Append this run to a history file (JSON lines) and chart it");
     r->add_option("--goldens", goldens, "Golden folder (default: goldens/)");
     r->add_option("--device", run.device, "Vulkan device/driver name substring (default: lavapipe)");
-    r->add_flag("--quiet,-q", run.quiet, "No per-test lines");
+    r->add_flag("--quiet,-q", run.quiet, "No per-test lines (the summary line stays)");
     static bool list_only = false;
     r->add_flag("--list", list_only, "Print the selected tests' names and exit");
     r->add_flag("--stability", run.stability, "Also measure determinism, noise floors, sensitivity and margins");
@@ -78,16 +78,19 @@ void register_run_commands(CLI::App& app, int& exit_code) {
     });
 
     static BlessOptions bo;
-    static std::string bless_goldens;
+    static std::string bless_goldens, label;
     auto* b = app.add_subcommand("bless", "Re-render and write baseline goldens (the only writer of goldens)");
     b->add_option("--suite", bo.suite, "Suite name or path")->capture_default_str();
     b->add_option("--filter", bo.filter, "Glob on test names (default: every test of the suite)");
-    b->add_option("--label", bo.label, "Write an alternate approved baseline <test>@LABEL (e.g. a platform)");
+    auto* label_opt = b->add_option("--label", label,
+                                    "Write an alternate approved baseline <test>@LABEL for a known platform difference "
+                                    "(LABEL: A-Z a-z 0-9 . _ -)");
     b->add_option("--goldens", bless_goldens, "Golden folder (default: goldens/)");
     b->add_option("--device", bo.device, "Vulkan device/driver name substring");
     b->add_flag("--dry-run", bo.dry_run, "Show what would change, write nothing");
-    b->callback([&exit_code] {
+    b->callback([&exit_code, label_opt] {
         bo.goldens = bless_goldens;
+        if (label_opt->count() > 0) bo.label = label;  // given, even empty: check_label refuses ""
         exit_code = bless(bo);
     });
 

@@ -1,4 +1,4 @@
-// Error types shared by every module. The CLI maps them to exit codes (DESIGN.md, Conventions):
+// Error types shared by every module. The CLI maps them to exit codes (docs/DESIGN.md, Conventions):
 // 0 pass, 1 regression, 2 usage/input/environment error. Messages name the file and the problem.
 #pragma once
 #include <stdexcept>
@@ -25,6 +25,11 @@ struct InputError : Error {
 };
 // The machine cannot run the job: no Vulkan driver, missing feature.
 struct EnvironmentError : Error {
+    using Error::Error;
+};
+// A render completed but its pixels are not finite (NaN/Inf): the shader under test is wrong, so
+// this is a regression (verdict fail, exit 1, bisect "bad"), not "cannot test".
+struct NonFiniteRender : Error {
     using Error::Error;
 };
 // A GLSL source failed to compile; the message carries file:line.

@@ -1,4 +1,4 @@
-// Options have one spelling everywhere (DESIGN.md): CLI `--set key=value`, suite files, results
+// Options have one spelling everywhere (docs/DESIGN.md): CLI `--set key=value`, suite files, results
 // JSON and the report all use the same key=value strings. OptionMap keeps them as strings and
 // parses on read, so an unknown key or a malformed value is caught in one place with a message
 // that names the key.

@@ -14,9 +14,12 @@ class GpuSession {
     explicit GpuSession(const vk::ContextOptions& options = {});
     vk::Context& ctx() { return *ctx_; }
 
-    // The pipeline for `shader` compiled with `defines`, binding types in binding order.
+    // The pipeline for `shader` compiled with `defines` and `options` (the fp16 emulation pass; the
+    // instruction-count instrumentation of renderers/vulkan/spirv_cost.h, for an untimed dispatch that
+    // measures the pass's cost), binding types in binding order.
     const vk::ComputePipeline& pipeline(const std::string& shader, const vk::Defines& defines,
-                                        const std::vector<VkDescriptorType>& bindings, uint32_t push_bytes);
+                                        const std::vector<VkDescriptorType>& bindings, uint32_t push_bytes,
+                                        const vk::CompileOptions& options = {});
     // A per-session cache of anything built on the device (the precompute passes' results, keyed by
     // environment hash + settings): an animated sequence re-renders the same environment per frame.
     template <class T> std::shared_ptr<T> cached(const std::string& key) {

@@ -1,11 +1,14 @@
 #include "mobile_renderer.h"
 
 #include <chrono>
+#include <optional>
 
 #include "gpu_scene.h"
 #include "harness/common/errors.h"
 #include "ibl_precompute.h"
 #include "renderers/scenes/scene.h"
+#include "shading_cost.h"
+#include "renderers/vulkan/fp16_emulation.h"
 
 namespace iblcheck {
 
@@ -44,8 +47,14 @@ RenderResult render_mobile(GpuSession& gpu, const Environment& env, const TestSp
     std::string spec_aa = o.get_choice("specular_aa", "off", {"off", "tokuyoshi", "rjump", "toksvig"});
     if (ps.prefilter_samples < 1 || ps.prefilter_samples > 65536)
         throw UsageError("option 'prefilter_samples' must be in 1..65536");
-    if (precision == "mediump" && !gpu.ctx().info().shader_float16)
-        throw EnvironmentError(gpu.ctx().info().device_name + ": precision=mediump needs shaderFloat16");
+    std::string fp16 = o.get_choice("fp16", "auto", {"auto", "native", "emulated"});
+    // precision=mediump computes in float16_t: natively, or emulated where the device lacks
+    // shaderFloat16 (or fp16=emulated asks for it). One rule, shared with `iblcheck doctor`.
+    std::optional<vk::Fp16Path> fp16_path;
+    if (precision == "mediump")
+        fp16_path = vk::choose_fp16_path(fp16, gpu.ctx().info().shader_float16, gpu.ctx().info().device_name);
+    vk::CompileOptions shade_options;
+    shade_options.emulate_fp16 = fp16_path == vk::Fp16Path::emulated;
 
     RenderResult result;
     bool cached = false;
@@ -60,8 +69,8 @@ RenderResult render_mobile(GpuSession& gpu, const Environment& env, const TestSp
     defs["NORMALIZATION"] = index_of("normalization", normalization, {"off", "ue4"});
     defs["PRECISION_MEDIUMP"] = precision == "mediump" ? "1" : "0";
     defs["SPECULAR_AA"] = index_of("specular_aa", spec_aa, {"off", "tokuyoshi", "rjump", "toksvig"});
-    const auto& shade = gpu.pipeline("shade_spheres.comp", defs,
-                                     {kStorageBuffer, kSampled, kStorageBuffer, kSampled, kSampled, kStorageBuffer}, 48);
+    const std::vector<VkDescriptorType> types = {kStorageBuffer, kSampled, kStorageBuffer, kSampled, kSampled, kStorageBuffer};
+    const auto& shade = gpu.pipeline("shade_spheres.comp", defs, types, 48, shade_options);
 
     vk::Context& ctx = gpu.ctx();
     vk::Buffer scene_buf = upload_scene(ctx, scene);
@@ -85,15 +94,15 @@ RenderResult render_mobile(GpuSession& gpu, const Environment& env, const TestSp
     if (pc.ssaa < 1 || pc.ssaa > 16) throw UsageError("option 'ssaa' must be in 1..16");
     if (pc.mix_end <= pc.mix_begin) throw UsageError("option 'mix_end_roughness' must exceed 'mix_begin_roughness'");
 
+    std::vector<vk::Binding> b = {vk::Binding::storage_buffer(0, scene_buf),
+                                  vk::Binding::sampled_image(1, ibl.prefiltered.sampled_view, ctx.linear_sampler()),
+                                  vk::Binding::storage_buffer(2, ibl.sh),
+                                  vk::Binding::sampled_image(3, ibl.lut.sampled_view, ctx.linear_sampler()),
+                                  vk::Binding::sampled_image(4, ibl.irradiance.sampled_view, ctx.linear_sampler()),
+                                  vk::Binding::storage_buffer(5, out)};
     vk::GpuTimer timer(ctx, 1);
     ctx.submit([&](VkCommandBuffer cmd) {
         timer.reset(cmd);
-        std::vector<vk::Binding> b = {vk::Binding::storage_buffer(0, scene_buf),
-                                      vk::Binding::sampled_image(1, ibl.prefiltered.sampled_view, ctx.linear_sampler()),
-                                      vk::Binding::storage_buffer(2, ibl.sh),
-                                      vk::Binding::sampled_image(3, ibl.lut.sampled_view, ctx.linear_sampler()),
-                                      vk::Binding::sampled_image(4, ibl.irradiance.sampled_view, ctx.linear_sampler()),
-                                      vk::Binding::storage_buffer(5, out)};
         shade.warm_up(cmd, b, &pc, sizeof pc);
         timer.begin(cmd, "shade_spheres");
         shade.dispatch(cmd, b, &pc, sizeof pc, (width + 7) / 8, (height + 7) / 8, 1);
@@ -106,12 +115,16 @@ RenderResult render_mobile(GpuSession& gpu, const Environment& env, const TestSp
     // irradiance cube when used (SH9 is arithmetic).
     double per_hit = 1.0 + (ps.lut ? 1.0 : 0.0) + (ps.irradiance_cube ? 1.0 : 0.0);
     result.texture_fetches_per_pixel = coverage * pc.ssaa * pc.ssaa * per_hit;
+    auto instructions = shading_instructions_per_pixel(gpu, {"shade_spheres.comp", defs, types, shade_options, b, 5, &pc, sizeof pc, width, height}, out);
+    result.shader_instructions_per_pixel = instructions.value_or(0);
     result.provenance = {{"method", "mobile"},
+                         {"cost", cost_provenance(instructions, result.texture_fetches_per_pixel)},
                          {"precompute_cached", cached},
                          {"cube_size", ps.cube_size},
                          {"mips", std::min(ps.mips, ibl.full_mips)},
                          {"storage_native", ps.storage != "r11g11b10" || ibl.native_r11g11b10},
                          {"shader_defines", defs}};
+    if (fp16_path) result.provenance["fp16"] = vk::fp16_path_name(*fp16_path);
     return result;
 }
 

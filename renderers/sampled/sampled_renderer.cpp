@@ -4,6 +4,7 @@
 #include "renderers/mobile/gpu_scene.h"
 #include "renderers/mobile/ibl_precompute.h"
 #include "renderers/mobile/mobile_renderer.h"
+#include "renderers/mobile/shading_cost.h"
 
 namespace iblcheck {
 
@@ -23,11 +24,10 @@ RenderResult render_sampled(GpuSession& gpu, const Environment& env, const TestS
     bool cached = false;
     auto ibl_ptr = precompute_cached(gpu, env, ps, result.timings, cached);
     const IblResources& ibl = *ibl_ptr;
-    const auto& shade = gpu.pipeline("shade_sampled.comp", {},
-                                     {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-                                      VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-                                      VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
-                                     36);
+    const std::vector<VkDescriptorType> types = {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+                                                 VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+                                                 VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
+    const auto& shade = gpu.pipeline("shade_sampled.comp", {}, types, 36);
     vk::Context& ctx = gpu.ctx();
     vk::Buffer scene_buf = upload_scene(ctx, scene);
     vk::Buffer out = ctx.create_buffer(VkDeviceSize(width) * height * 16);
@@ -39,14 +39,14 @@ RenderResult render_sampled(GpuSession& gpu, const Environment& env, const TestS
          float(o.get_double("diffuse_roughness", 0.9))};
     if (pc.ssaa < 1 || pc.ssaa > 16) throw UsageError("option 'ssaa' must be in 1..16");
 
+    // Bindings 3 and 4 are unused by this shader; the layout keeps the mobile numbering.
+    std::vector<vk::Binding> b = {vk::Binding::storage_buffer(0, scene_buf),
+                                  vk::Binding::sampled_image(1, ibl.source_cube.sampled_view, ctx.linear_sampler()),
+                                  vk::Binding::storage_buffer(2, ibl.sh), vk::Binding::storage_buffer(3, ibl.sh),
+                                  vk::Binding::storage_buffer(4, ibl.sh), vk::Binding::storage_buffer(5, out)};
     vk::GpuTimer timer(ctx, 1);
     ctx.submit([&](VkCommandBuffer cmd) {
         timer.reset(cmd);
-        // Bindings 3 and 4 are unused by this shader; the layout keeps the mobile numbering.
-        std::vector<vk::Binding> b = {vk::Binding::storage_buffer(0, scene_buf),
-                                      vk::Binding::sampled_image(1, ibl.source_cube.sampled_view, ctx.linear_sampler()),
-                                      vk::Binding::storage_buffer(2, ibl.sh), vk::Binding::storage_buffer(3, ibl.sh),
-                                      vk::Binding::storage_buffer(4, ibl.sh), vk::Binding::storage_buffer(5, out)};
         shade.warm_up(cmd, b, &pc, sizeof pc);
         timer.begin(cmd, "shade_sampled");
         shade.dispatch(cmd, b, &pc, sizeof pc, (width + 7) / 8, (height + 7) / 8, 1);
@@ -56,8 +56,10 @@ RenderResult render_sampled(GpuSession& gpu, const Environment& env, const TestS
     for (auto& [name, ms] : timer.results()) result.timings.push_back({name, ms, true, false});
     double coverage = read_back_image(out, width, height, result.image);
     result.texture_fetches_per_pixel = coverage * pc.ssaa * pc.ssaa * samples;
+    auto instructions = shading_instructions_per_pixel(gpu, {"shade_sampled.comp", {}, types, {}, b, 5, &pc, sizeof pc, width, height}, out);
+    result.shader_instructions_per_pixel = instructions.value_or(0);
     result.provenance = {{"method", "sampled"}, {"precompute_cached", cached}, {"samples", samples}, {"cube_size", ps.cube_size},
-                         {"seed", pc.seed}};
+                         {"seed", pc.seed}, {"cost", cost_provenance(instructions, result.texture_fetches_per_pixel)}};
     return result;
 }
 

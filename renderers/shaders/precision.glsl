@@ -1,7 +1,9 @@
 // Shading precision (option precision). PRECISION_MEDIUMP 1 computes the shading in explicit
 // float16_t: lavapipe ignores the mediump qualifier (RelaxedPrecision) but computes float16_t as
 // true fp16, so this is what a mobile GPU's half precision does to the result (max 65504,
-// 11-bit mantissa). Needs shaderFloat16; the host refuses the variant without it.
+// 11-bit mantissa). Without shaderFloat16 the host emulates it (option fp16,
+// renderers/vulkan/fp16_emulation.h): every float16_t becomes a float rounded to fp16 after each
+// operation.
 #ifndef IBLCHECK_PRECISION_GLSL
 #define IBLCHECK_PRECISION_GLSL
 #ifndef PRECISION_MEDIUMP

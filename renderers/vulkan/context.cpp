@@ -1,11 +1,23 @@
 #include "context.h"
 
+#include <type_traits>
+
 #include <cstring>
 #include <regex>
 
 #include "harness/common/errors.h"
+#include "spirv_cost.h"
 
 namespace iblcheck::vk {
+
+// A Vulkan info struct with its sType set and every other member zero (value-initialised, so
+// -Wmissing-field-initializers has nothing to say).
+template <class T> std::remove_cvref_t<T> vk_struct(VkStructureType type) {
+    std::remove_cvref_t<T> t{};
+    t.sType = type;
+    return t;
+}
+
 
 namespace {
 
@@ -61,7 +73,7 @@ const char* type_name(VkPhysicalDeviceType t) {
 }
 
 VkInstance create_instance(bool validation) {
-    VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
+    auto app = vk_struct<VkApplicationInfo>(VK_STRUCTURE_TYPE_APPLICATION_INFO);
     app.pApplicationName = "iblcheck";
     app.apiVersion = VK_API_VERSION_1_2;
     std::vector<const char*> layers, exts;
@@ -69,7 +81,7 @@ VkInstance create_instance(bool validation) {
         layers.push_back(kValidationLayer);
         exts.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
     }
-    VkInstanceCreateInfo ci{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
+    auto ci = vk_struct<VkInstanceCreateInfo>(VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO);
     ci.pApplicationInfo = &app;
     ci.enabledLayerCount = uint32_t(layers.size());
     ci.ppEnabledLayerNames = layers.data();
@@ -96,9 +108,10 @@ std::vector<DeviceEntry> enumerate(VkInstance inst) {
     vkEnumeratePhysicalDevices(inst, &n, pds.data());
     std::vector<DeviceEntry> out;
     for (auto pd : pds) {
-        DeviceEntry e{pd};
-        e.driver = {VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES};
-        VkPhysicalDeviceProperties2 p2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
+        DeviceEntry e{};
+        e.pd = pd;
+        e.driver = vk_struct<decltype(e.driver)>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES);
+        auto p2 = vk_struct<VkPhysicalDeviceProperties2>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2);
         p2.pNext = &e.driver;
         vkGetPhysicalDeviceProperties2(pd, &p2);
         e.props = p2.properties;
@@ -144,7 +157,7 @@ Context::Context(const ContextOptions& options) {
     instance_ = create_instance(validation);
     try {
         if (validation) {
-            VkDebugUtilsMessengerCreateInfoEXT mi{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
+            auto mi = vk_struct<VkDebugUtilsMessengerCreateInfoEXT>(VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT);
             mi.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT |
                                  VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT;
             mi.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT |
@@ -209,33 +222,36 @@ Context::Context(const ContextOptions& options) {
         if (!found) throw EnvironmentError(info_.device_name + ": no compute queue");
 
         // Features the harness uses: float16 arithmetic (precision=mediump) and 16-bit storage.
-        VkPhysicalDeviceVulkan11Features f11{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_FEATURES};
-        VkPhysicalDeviceVulkan12Features f12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
+        auto f11 = vk_struct<VkPhysicalDeviceVulkan11Features>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_FEATURES);
+        auto f12 = vk_struct<VkPhysicalDeviceVulkan12Features>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES);
         f11.pNext = &f12;
-        VkPhysicalDeviceFeatures2 f2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
+        auto f2 = vk_struct<VkPhysicalDeviceFeatures2>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2);
         f2.pNext = &f11;
         vkGetPhysicalDeviceFeatures2(physical_, &f2);
         info_.shader_float16 = f12.shaderFloat16;
         info_.storage_16bit = f11.storageBuffer16BitAccess;
+        info_.int64_atomics = f2.features.shaderInt64 && f12.shaderBufferInt64Atomics;
 
-        VkPhysicalDeviceVulkan11Features e11{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_FEATURES};
-        VkPhysicalDeviceVulkan12Features e12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
+        auto e11 = vk_struct<VkPhysicalDeviceVulkan11Features>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_FEATURES);
+        auto e12 = vk_struct<VkPhysicalDeviceVulkan12Features>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES);
         e11.pNext = &e12;
         e11.storageBuffer16BitAccess = f11.storageBuffer16BitAccess;
         e12.shaderFloat16 = f12.shaderFloat16;
         e12.hostQueryReset = f12.hostQueryReset;
-        VkPhysicalDeviceFeatures2 e2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
+        auto e2 = vk_struct<VkPhysicalDeviceFeatures2>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2);
         e2.pNext = &e11;
         e2.features.shaderInt16 = f2.features.shaderInt16;
         e2.features.shaderFloat64 = f2.features.shaderFloat64;
+        e2.features.shaderInt64 = f2.features.shaderInt64;                  // instruction counting
+        e12.shaderBufferInt64Atomics = f12.shaderBufferInt64Atomics;
 
         float prio = 1.0f;
-        VkDeviceQueueCreateInfo qci{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
+        auto qci = vk_struct<VkDeviceQueueCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO);
         qci.queueFamilyIndex = queue_family_;
         qci.queueCount = 1;
         qci.pQueuePriorities = &prio;
         const char* dev_exts[] = {VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME};
-        VkDeviceCreateInfo dci{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
+        auto dci = vk_struct<VkDeviceCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO);
         dci.pNext = &e2;
         dci.queueCreateInfoCount = 1;
         dci.pQueueCreateInfos = &qci;
@@ -249,14 +265,14 @@ Context::Context(const ContextOptions& options) {
         push_descriptor_fn_ = reinterpret_cast<PFN_vkCmdPushDescriptorSetKHR>(
             vkGetDeviceProcAddr(device_, "vkCmdPushDescriptorSetKHR"));
 
-        VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+        auto pci = vk_struct<VkCommandPoolCreateInfo>(VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO);
         pci.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
         pci.queueFamilyIndex = queue_family_;
         check(vkCreateCommandPool(device_, &pci, nullptr, &pool_), "vkCreateCommandPool");
-        VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+        auto fci = vk_struct<VkFenceCreateInfo>(VK_STRUCTURE_TYPE_FENCE_CREATE_INFO);
         check(vkCreateFence(device_, &fci, nullptr, &fence_), "vkCreateFence");
 
-        VkSamplerCreateInfo sci{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
+        auto sci = vk_struct<VkSamplerCreateInfo>(VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO);
         sci.magFilter = sci.minFilter = VK_FILTER_LINEAR;
         sci.mipmapMode = VK_SAMPLER_MIPMAP_MODE_LINEAR;
         sci.addressModeU = sci.addressModeV = sci.addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
@@ -323,13 +339,13 @@ Buffer Context::create_buffer(VkDeviceSize size, VkBufferUsageFlags usage) {
     Buffer b;
     b.ctx = this;
     b.size = size;
-    VkBufferCreateInfo bci{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+    auto bci = vk_struct<VkBufferCreateInfo>(VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO);
     bci.size = size;
     bci.usage = usage;
     check(vkCreateBuffer(device_, &bci, nullptr, &b.buffer), "vkCreateBuffer");
     VkMemoryRequirements req;
     vkGetBufferMemoryRequirements(device_, b.buffer, &req);
-    VkMemoryAllocateInfo ai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+    auto ai = vk_struct<VkMemoryAllocateInfo>(VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO);
     ai.allocationSize = req.size;
     ai.memoryTypeIndex = find_memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT |
                                                                   VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
@@ -349,7 +365,7 @@ Image Context::create_image(VkFormat format, uint32_t width, uint32_t height, ui
     img.mips = mips;
     img.layers = cube ? 6 : 1;
     img.cube = cube;
-    VkImageCreateInfo ici{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
+    auto ici = vk_struct<VkImageCreateInfo>(VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO);
     ici.flags = cube ? VK_IMAGE_CREATE_CUBE_COMPATIBLE_BIT : 0;
     ici.imageType = VK_IMAGE_TYPE_2D;
     ici.format = format;
@@ -364,13 +380,13 @@ Image Context::create_image(VkFormat format, uint32_t width, uint32_t height, ui
     check(vkCreateImage(device_, &ici, nullptr, &img.image), "vkCreateImage");
     VkMemoryRequirements req;
     vkGetImageMemoryRequirements(device_, img.image, &req);
-    VkMemoryAllocateInfo ai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+    auto ai = vk_struct<VkMemoryAllocateInfo>(VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO);
     ai.allocationSize = req.size;
     ai.memoryTypeIndex = find_memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
     check(vkAllocateMemory(device_, &ai, nullptr, &img.memory), "vkAllocateMemory");
     check(vkBindImageMemory(device_, img.image, img.memory, 0), "vkBindImageMemory");
 
-    VkImageViewCreateInfo vci{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
+    auto vci = vk_struct<VkImageViewCreateInfo>(VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO);
     vci.image = img.image;
     vci.viewType = cube ? VK_IMAGE_VIEW_TYPE_CUBE : VK_IMAGE_VIEW_TYPE_2D;
     vci.format = format;
@@ -425,13 +441,13 @@ Image::~Image() {
 }
 
 VkCommandBuffer Context::begin_commands() {
-    VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+    auto ai = vk_struct<VkCommandBufferAllocateInfo>(VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO);
     ai.commandPool = pool_;
     ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
     ai.commandBufferCount = 1;
     VkCommandBuffer cmd;
     check(vkAllocateCommandBuffers(device_, &ai, &cmd), "vkAllocateCommandBuffers");
-    VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+    auto bi = vk_struct<VkCommandBufferBeginInfo>(VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO);
     bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
     check(vkBeginCommandBuffer(cmd, &bi), "vkBeginCommandBuffer");
     return cmd;
@@ -439,7 +455,7 @@ VkCommandBuffer Context::begin_commands() {
 
 void Context::end_and_wait(VkCommandBuffer cmd) {
     check(vkEndCommandBuffer(cmd), "vkEndCommandBuffer");
-    VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+    auto si = vk_struct<VkSubmitInfo>(VK_STRUCTURE_TYPE_SUBMIT_INFO);
     si.commandBufferCount = 1;
     si.pCommandBuffers = &cmd;
     check(vkQueueSubmit(queue_, 1, &si, fence_), "vkQueueSubmit");
@@ -449,7 +465,7 @@ void Context::end_and_wait(VkCommandBuffer cmd) {
 }
 
 void Context::barrier(VkCommandBuffer cmd) {
-    VkMemoryBarrier mb{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    auto mb = vk_struct<VkMemoryBarrier>(VK_STRUCTURE_TYPE_MEMORY_BARRIER);
     mb.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
     mb.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT |
                        VK_ACCESS_HOST_READ_BIT;
@@ -460,7 +476,7 @@ void Context::barrier(VkCommandBuffer cmd) {
 }
 
 void Context::transition(VkCommandBuffer cmd, const Image& img, VkImageLayout from, VkImageLayout to) {
-    VkImageMemoryBarrier b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
+    auto b = vk_struct<VkImageMemoryBarrier>(VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER);
     b.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
     b.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
     b.oldLayout = from;
@@ -543,20 +559,24 @@ ComputePipeline::ComputePipeline(Context& ctx, const CompiledShader& shader,
     std::vector<VkDescriptorSetLayoutBinding> lb;
     for (uint32_t i = 0; i < bindings.size(); ++i)
         lb.push_back({i, bindings[i], 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr});
-    VkDescriptorSetLayoutCreateInfo dl{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+    if (shader.counts_instructions && bindings.size() > kCostBinding)
+        throw Error("ComputePipeline: binding " + std::to_string(kCostBinding) + " is the instruction counter's");
+    if (shader.counts_instructions)
+        lb.push_back({kCostBinding, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr});
+    auto dl = vk_struct<VkDescriptorSetLayoutCreateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO);
     dl.flags = VK_DESCRIPTOR_SET_LAYOUT_CREATE_PUSH_DESCRIPTOR_BIT_KHR;
     dl.bindingCount = uint32_t(lb.size());
     dl.pBindings = lb.data();
     check(vkCreateDescriptorSetLayout(dev, &dl, nullptr, &set_layout_), "vkCreateDescriptorSetLayout");
     VkPushConstantRange pcr{VK_SHADER_STAGE_COMPUTE_BIT, 0, push_constant_bytes};
-    VkPipelineLayoutCreateInfo pl{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+    auto pl = vk_struct<VkPipelineLayoutCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO);
     pl.setLayoutCount = 1;
     pl.pSetLayouts = &set_layout_;
     pl.pushConstantRangeCount = push_constant_bytes ? 1 : 0;
     pl.pPushConstantRanges = &pcr;
     check(vkCreatePipelineLayout(dev, &pl, nullptr, &layout_), "vkCreatePipelineLayout");
 
-    VkShaderModuleCreateInfo smi{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+    auto smi = vk_struct<VkShaderModuleCreateInfo>(VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO);
     smi.codeSize = shader.spirv.size() * 4;
     smi.pCode = shader.spirv.data();
     VkShaderModule module;
@@ -568,8 +588,8 @@ ComputePipeline::ComputePipeline(Context& ctx, const CompiledShader& shader,
         data.push_back(s.value);
     }
     VkSpecializationInfo si{uint32_t(entries.size()), entries.data(), data.size() * 4, data.data()};
-    VkComputePipelineCreateInfo ci{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
-    ci.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+    auto ci = vk_struct<VkComputePipelineCreateInfo>(VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO);
+    ci.stage = vk_struct<decltype(ci.stage)>(VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO);
     ci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
     ci.stage.module = module;
     ci.stage.pName = "main";
@@ -596,7 +616,7 @@ void ComputePipeline::dispatch(VkCommandBuffer cmd, const std::vector<Binding>& 
     for (size_t i = 0; i < bindings.size(); ++i) {
         const Binding& b = bindings[i];
         VkWriteDescriptorSet& w = writes[i];
-        w = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+        w = vk_struct<decltype(w)>(VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET);
         w.dstBinding = b.binding;
         w.descriptorCount = 1;
         w.descriptorType = b.type;
@@ -622,7 +642,7 @@ void ComputePipeline::warm_up(VkCommandBuffer cmd, const std::vector<Binding>& b
 }
 
 GpuTimer::GpuTimer(Context& ctx, uint32_t max_passes) : ctx_(ctx), max_(max_passes) {
-    VkQueryPoolCreateInfo qi{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+    auto qi = vk_struct<VkQueryPoolCreateInfo>(VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO);
     qi.queryType = VK_QUERY_TYPE_TIMESTAMP;
     qi.queryCount = 2 * max_passes;
     check(vkCreateQueryPool(ctx.device(), &qi, nullptr, &pool_), "vkCreateQueryPool");

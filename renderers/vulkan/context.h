@@ -32,6 +32,7 @@ struct DeviceInfo {
     uint32_t vendor_id = 0, device_id = 0;
     bool shader_float16 = false;
     bool storage_16bit = false;
+    bool int64_atomics = false; // shaderInt64 + shaderBufferInt64Atomics: instruction counting (spirv_cost.h)
     bool timestamps = false;
     double timestamp_period_ns = 1;
     bool validation = false;

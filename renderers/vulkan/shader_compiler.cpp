@@ -12,8 +12,11 @@
 #include <set>
 #include <sstream>
 
+#include "fp16_emulation.h"
+#include "fp16_pass_hash.h"  // generated: IBLCHECK_FP16_PASS_HASH
 #include "harness/common/errors.h"
 #include "harness/common/hash.h"
+#include "spirv_cost.h"
 
 namespace fs = std::filesystem;
 
@@ -131,13 +134,14 @@ std::string shader_tree_hash() {
     return h.hex();
 }
 
-CompiledShader compile_compute_shader(const std::string& name, const Defines& defines) {
+CompiledShader compile_compute_shader(const std::string& name, const Defines& defines, const CompileOptions& options) {
     fs::path p = shader_dir() / name;
     if (!fs::exists(p)) throw ShaderCompileError(p.string() + ": shader source not found");
-    return compile_compute_shader_file(p, defines);
+    return compile_compute_shader_file(p, defines, options);
 }
 
-CompiledShader compile_compute_shader_file(const fs::path& path_in, const Defines& defines) {
+CompiledShader compile_compute_shader_file(const fs::path& path_in, const Defines& defines,
+                                           const CompileOptions& options) {
     fs::path path = fs::weakly_canonical(path_in);
     Fnv1a64 h;
     h.update("comp;glslang-vulkan1.2;");
@@ -148,8 +152,11 @@ CompiledShader compile_compute_shader_file(const fs::path& path_in, const Define
         preamble += "#define " + k + " " + v + "\n";
         h.update(k + "=" + v + ";");
     }
+    if (options.count_instructions) h.update("count_instructions=" + std::to_string(kCostPassVersion) + ";");
+    if (options.emulate_fp16) h.update("pass:fp16-emulation:" IBLCHECK_FP16_PASS_HASH ";");
     CompiledShader out;
     out.source_hash = h.hex();
+    out.counts_instructions = options.count_instructions;
 
     fs::path cached = spirv_cache_dir() / (out.source_hash + ".spv");
     if (std::ifstream f{cached, std::ios::binary}) {
@@ -188,6 +195,18 @@ CompiledShader compile_compute_shader_file(const fs::path& path_in, const Define
         glslang::SpvOptions opt;
         opt.disableOptimizer = true;  // lavapipe's LLVM optimises; keep SPIR-V faithful to the source
         glslang::GlslangToSpv(*program.getIntermediate(EShLangCompute), out.spirv, &opt);
+    }
+    // The count comes before the fp16 emulation: it measures the shader as written (what a device
+    // with native fp16 executes), so the cost a baseline records is the same on every CPU class.
+    // The emulation only rewrites 16-bit float instructions and adds no blocks, so the counter's
+    // per-block increments (64-bit integers) pass through it unchanged.
+    if (options.count_instructions) out.spirv = instrument_instruction_count(out.spirv);
+    if (options.emulate_fp16) {
+        try {
+            emulate_fp16(out.spirv);
+        } catch (const ShaderCompileError& e) {
+            throw ShaderCompileError(path.string() + ": " + e.what());
+        }
     }
 
     std::error_code ec;

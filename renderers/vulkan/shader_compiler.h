@@ -5,7 +5,7 @@
 // relative to the including file, then to the shader folder. Variants are preprocessor defines
 // (named as the options are: DOMINANT_DIR, MIP_MAPPING, ...) or specialization constants set at
 // pipeline creation. Compiled SPIR-V is cached on disk, keyed by a hash of the source text of
-// the file and everything it includes, plus the defines and the stage.
+// the file and everything it includes, plus the defines, the stage and the CompileOptions.
 #pragma once
 #include <cstdint>
 #include <filesystem>
@@ -17,10 +17,21 @@ namespace iblcheck::vk {
 
 using Defines = std::map<std::string, std::string>;
 
+// What is done to the SPIR-V after glslang (each part of the cache key).
+struct CompileOptions {
+    // Run the fp16 emulation pass (fp16_emulation.h): float16_t arithmetic on a driver without
+    // shaderFloat16. A no-op on modules without 16-bit floats.
+    bool emulate_fp16 = false;
+    // Instrument the SPIR-V to count the instructions each invocation executes (spirv_cost.h).
+    // Applied last, so it counts exactly what the pipeline runs.
+    bool count_instructions = false;
+};
+
 struct CompiledShader {
     std::vector<uint32_t> spirv;
-    std::string source_hash; // hash of the sources + defines: the key of the cache, for provenance
+    std::string source_hash; // hash of the sources + defines + options: the key of the cache, for provenance
     bool from_cache = false;
+    bool counts_instructions = false; // instrumented by spirv_cost.h: binds the counter at kCostBinding
 };
 
 // The folder shaders are read from: $IBLCHECK_SHADER_DIR or <source root>/renderers/shaders.
@@ -28,10 +39,12 @@ std::filesystem::path shader_dir();
 
 // Compiles the compute shader `name` (a file under shader_dir(), e.g. "prefilter_ggx.comp").
 // Throws ShaderCompileError whose message starts "file:line: " for every error glslang reports.
-CompiledShader compile_compute_shader(const std::string& name, const Defines& defines = {});
+CompiledShader compile_compute_shader(const std::string& name, const Defines& defines = {},
+                                      const CompileOptions& options = {});
 
 // Same, for a full path (tests compile shaders from temporary folders).
-CompiledShader compile_compute_shader_file(const std::filesystem::path& path, const Defines& defines = {});
+CompiledShader compile_compute_shader_file(const std::filesystem::path& path, const Defines& defines = {},
+                                           const CompileOptions& options = {});
 
 // A hash over every .glsl/.comp file in shader_dir(): the "shader source hash" of provenance.
 std::string shader_tree_hash();

@@ -1,0 +1,34 @@
+// `iblcheck bless`: the only writer of baseline goldens. It re-renders the selected tests and
+// writes each baseline with its provenance sidecar (scene, options, shader hash, driver, CPU,
+// commit, date, accuracy against the truth, cost per pixel) atomically. A baseline whose pixels
+// are bit-identical is left as it is (no git churn); its sidecar is rewritten only when a judged
+// figure in it (accuracy, cost, size) changed.
+#pragma once
+#include <filesystem>
+#include <optional>
+#include <string>
+
+#include "suite.h"
+
+namespace iblcheck {
+
+struct BlessOptions {
+    std::string suite = "ci";
+    std::string filter;
+    std::optional<std::string> label;   // absent: the primary baseline; else baseline@LABEL
+    std::filesystem::path goldens;
+    std::string device;
+    bool dry_run = false;
+};
+
+// Labels name files: [A-Za-z0-9._-]+ only (no '/', no empty label). Throws UsageError otherwise.
+void check_label(const std::string& label);
+
+// Re-renders and writes baselines; returns the exit code (2 if any render or write failed: nothing
+// is written for a failed render).
+int bless(const BlessOptions& options);
+
+// The bless command that approves a test (shown on failure).
+std::string bless_command(const TestCase& t);
+
+} // namespace iblcheck

@@ -1,0 +1,24 @@
+// Metrics of a render against a golden, as results JSON (the keys `iblcheck compare --json`
+// prints), and the per-sphere breakdown of an error map. Measures only: harness/verdict.h judges.
+#pragma once
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+
+#include "metrics/flip.h"
+#include "renderers/render_api.h"
+
+namespace iblcheck {
+
+// HDR-FLIP, SSIM (on the display transform; null with "not_applicable" under 11x11) and PSNR of
+// `test` against `golden` (same size, finite). `flip_out` receives the FLIP result with its map.
+nlohmann::json compare_images(const cv::Mat& golden, const cv::Mat& test, int flip_threads,
+                              FlipResult* flip_out = nullptr);
+
+// Mean FLIP per sphere of a multi-sphere scene (null for single-sphere scenes), labelled with the
+// scene's sphere names.
+nlohmann::json per_sphere_errors(const TestSpec& spec, const cv::Mat& errmap);
+
+// The sphere under pixel (x, y) of a render of `spec` ("metal r=0.3"), or "" for the background.
+std::string sphere_at(const TestSpec& spec, int width, int height, int x, int y);
+
+} // namespace iblcheck

@@ -1,0 +1,26 @@
+// One runner thread's renderer and what it keeps between tests: the GPU session (pipelines,
+// precomputed IBL) and the tone-mapped frames of sequences already rendered (the reference and
+// `off` sequences are shared by every specular-AA variant of a scene).
+#pragma once
+#include <map>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "renderers/renderer.h"
+
+namespace iblcheck {
+
+struct Worker {
+    explicit Worker(const std::string& device);
+    Renderer renderer;
+    std::string device;
+    std::map<std::string, std::vector<cv::Mat>> sequences;
+
+    // The display-transformed frames 0..frames-1 of `spec` (cached). Throws InputError naming the
+    // frame when one has non-finite pixels.
+    const std::vector<cv::Mat>& sequence(TestSpec spec, int frames);
+};
+
+} // namespace iblcheck

@@ -1,0 +1,33 @@
+#include "shading_cost.h"
+
+#include <cstring>
+
+#include "harness/common/errors.h"
+#include "renderers/vulkan/spirv_cost.h"
+
+namespace iblcheck {
+
+std::optional<double> shading_instructions_per_pixel(GpuSession& gpu, const ShadingPass& pass, const vk::Buffer& out) {
+    vk::Context& ctx = gpu.ctx();
+    if (!ctx.info().int64_atomics) return std::nullopt;
+    vk::CompileOptions options = pass.options;
+    options.count_instructions = true;
+    const vk::ComputePipeline& counted = gpu.pipeline(pass.shader, pass.defines, pass.binding_types, pass.push_bytes, options);
+    vk::Buffer scratch = ctx.create_buffer(out.size);
+    std::vector<vk::Binding> bindings = pass.bindings;
+    for (vk::Binding& b : bindings)
+        if (b.binding == pass.out_binding) b.buffer = scratch.buffer;
+    uint64_t total = vk::count_dispatch_instructions(ctx, counted, bindings, pass.push, pass.push_bytes,
+                                                     uint32_t(pass.width + 7) / 8, uint32_t(pass.height + 7) / 8, 1);
+    if (std::memcmp(scratch.mapped, out.mapped, size_t(out.size)) != 0)
+        throw Error(pass.shader + ": the instruction-counting twin computed another image than the timed pass; "
+                    "its count would not describe the frame");
+    return double(total) / (double(pass.width) * pass.height);
+}
+
+nlohmann::json cost_provenance(std::optional<double> instructions_per_pixel, double texture_fetches_per_pixel) {
+    return {{"spirv_instructions_per_pixel", instructions_per_pixel ? nlohmann::json(*instructions_per_pixel) : nlohmann::json()},
+            {"texture_fetches_per_pixel", texture_fetches_per_pixel}};
+}
+
+} // namespace iblcheck

@@ -1,0 +1,47 @@
+// Helpers every test file shares: private temporary folders, running the CLI, reading and writing
+// small text files.
+#pragma once
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+
+namespace iblcheck::testutil {
+
+// An empty folder under the system temp folder, unique to this process: <tmp>/iblcheck_<name>_<pid>.
+inline std::filesystem::path temp_dir(const std::string& name) {
+    std::filesystem::path p =
+        std::filesystem::temp_directory_path() / ("iblcheck_" + name + "_" + std::to_string(::getpid()));
+    std::filesystem::remove_all(p);
+    std::filesystem::create_directories(p);
+    return p;
+}
+
+// Runs a shell command; returns its exit status (-1 if it did not exit) and its output (stdout,
+// and stderr too unless merge_stderr is false, e.g. to parse JSON from stdout).
+inline int run_command(const std::string& cmd, std::string& out, bool merge_stderr = true) {
+    FILE* pipe = popen((merge_stderr ? cmd + " 2>&1" : cmd).c_str(), "r");
+    if (!pipe) return -1;
+    std::array<char, 4096> buf;
+    out.clear();
+    while (fgets(buf.data(), int(buf.size()), pipe)) out += buf.data();
+    int status = pclose(pipe);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+inline std::string read_text(const std::filesystem::path& p) {
+    std::ifstream f(p);
+    return std::string(std::istreambuf_iterator<char>(f), {});
+}
+
+inline void write_file(const std::filesystem::path& p, const std::string& text) {
+    std::filesystem::create_directories(p.parent_path());
+    std::ofstream(p) << text;
+}
+
+} // namespace iblcheck::testutil
