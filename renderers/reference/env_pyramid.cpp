@@ -294,8 +294,8 @@ void EnvPyramid::subcell_gauss(int i, int j, int n, int a, int b, V3 dir[4], dou
     }
 }
 
-double EnvPyramid::subcell_radius(int j, int n, int b) const {
-    const double dth = kPi / (double(H_) * n), th0 = (j + double(b) / n) * kPi / H_;
+double EnvPyramid::subcell_radius(int j, int n, int /*b: the bound holds for every sub-row*/) const {
+    const double dth = kPi / (double(H_) * n);
     const double smax = std::min(1.0, std::max(row_s_[size_t(j)], row_s_[size_t(j) + 1]) + dth);
     const double dph = 2 * kPi / (double(W_) * n) * smax;
     return 0.5 * std::sqrt(dth * dth + dph * dph) * 1.01;

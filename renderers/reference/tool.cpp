@@ -5,6 +5,7 @@
 // (reference.h, measure_noise_floor); the golden written is the seed-K image. --tiles WxH also prints the
 // noise floor per WxH tile (48x48 = one sphere of the roughness sweep), to see where the noise is.
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <ctime>
 #include <fstream>
@@ -13,6 +14,7 @@
 #include "metrics/flip.h"
 #include "metrics/image_io.h"
 #include "renderers/reference/reference.h"
+#include "renderers/reference/sphere_view.h"
 #include "renderers/reference/truth_golden.h"
 
 using namespace iblcheck;
@@ -51,13 +53,66 @@ static int run_truth(TestSpec spec, const std::string& out_path, const std::stri
     return 0;
 }
 
+// --diff A.exr B.exr [--tiles WxH]: mean HDR-FLIP (A as the reference) and relative RMSE between two images
+// over the pixels either covers, overall and per tile (48x48: one sphere of the roughness sweep), with the
+// worst pixel's relative RMSE term; for checking a new golden against the committed one sphere by sphere.
+static int run_diff(const std::string& a_path, const std::string& b_path, int tile_w, int tile_h, const TestSpec& spec) {
+    const cv::Mat a = read_image(a_path).pixels, b = read_image(b_path).pixels;
+    check_same_size(a, b, a_path, b_path);
+    cv::Mat cov(a.rows, a.cols, CV_32FC1, cv::Scalar(0));
+    for (int y = 0; y < a.rows; ++y)
+        for (int x = 0; x < a.cols; ++x) {
+            const cv::Vec3f &p = a.at<cv::Vec3f>(y, x), &q = b.at<cv::Vec3f>(y, x);
+            if (p[0] > 0 || p[1] > 0 || p[2] > 0 || q[0] > 0 || q[1] > 0 || q[2] > 0) cov.at<float>(y, x) = 1;
+        }
+    const FlipResult fr = compute_flip_hdr(a, b, FlipOptions{});
+    std::printf("%s vs %s: mean FLIP %.5f, relative RMSE %.4f%%\n", a_path.c_str(), b_path.c_str(), fr.mean,
+                100 * relative_rmse(a, b, cov));
+    if (!spec.scene.empty()) { // split by the exact coverage of the scene's silhouettes (truth/footprint.h)
+        const Scene scene = build_scene(spec.scene, spec.options);
+        cv::Mat full(a.rows, a.cols, CV_32FC1, cv::Scalar(0)), part(a.rows, a.cols, CV_32FC1, cv::Scalar(0));
+        for (const truth::SphereView& sv : truth::sphere_views(scene, a.cols, a.rows, truth::Lobes::all))
+            for (int y = 0; y < a.rows; ++y)
+                for (int x = 0; x < a.cols; ++x) {
+                    const double c = truth::disc_rect_area(sv.disc(), x, y, x + 1, y + 1);
+                    if (c >= 1 - 1e-9) full.at<float>(y, x) = 1;
+                    else if (c > 0) part.at<float>(y, x) = 1;
+                }
+        std::printf("  fully covered pixels (%d): mean FLIP %.5f, relative RMSE %.4f%%; silhouette pixels (%d): mean FLIP "
+                    "%.5f, relative RMSE %.4f%%\n",
+                    cv::countNonZero(full), cv::mean(fr.errmap, full > 0)[0], 100 * relative_rmse(a, b, full),
+                    cv::countNonZero(part), cv::mean(fr.errmap, part > 0)[0], 100 * relative_rmse(a, b, part));
+    }
+    if (tile_w <= 0) return 0;
+    std::printf("per %dx%d tile: mean FLIP over covered pixels / relative RMSE / worst pixel term (x,y)\n", tile_w, tile_h);
+    for (int ty = 0; ty < a.rows; ty += tile_h) {
+        for (int tx = 0; tx < a.cols; tx += tile_w) {
+            const cv::Rect rc(tx, ty, std::min(tile_w, a.cols - tx), std::min(tile_h, a.rows - ty));
+            double worst = 0;
+            int wx = -1, wy = -1;
+            for (int y = rc.y; y < rc.y + rc.height; ++y)
+                for (int x = rc.x; x < rc.x + rc.width; ++x) {
+                    if (cov.at<float>(y, x) <= 0) continue;
+                    for (int c = 0; c < 3; ++c) {
+                        const double p = a.at<cv::Vec3f>(y, x)[c], q = b.at<cv::Vec3f>(y, x)[c], m = 0.5 * (p + q);
+                        const double t = std::fabs(p - q) / std::sqrt(m * m + 0.01);
+                        if (t > worst) worst = t, wx = x, wy = y;
+                    }
+                }
+            std::printf("  tile %3d,%3d: FLIP %.5f  rel %.4f%%  worst %.4f (%d,%d)\n", tx, ty, cv::mean(fr.errmap(rc), cov(rc) > 0)[0],
+                        100 * relative_rmse(a(rc), b(rc), cov(rc)), worst, wx, wy);
+        }
+    }
+    return 0;
+}
+
 int main(int argc, char** argv) {
     try {
         TestSpec spec;
         spec.method = "reference";
         std::string out_path, meta_path, command;
         bool noise = false, truth = false;
-        std::string compare_path;
+        std::string compare_path, diff_a, diff_b;
         int tile_w = 0, tile_h = 0;
         int spp = kReferenceDefaultSpp, seed = 0;
         for (int i = 1; i < argc; ++i) {
@@ -80,6 +135,10 @@ int main(int argc, char** argv) {
             else if (a == "--command") command = next();
             else if (a == "--truth") truth = true;
             else if (a == "--compare") compare_path = next();
+            else if (a == "--diff") {
+                diff_a = next();
+                diff_b = next();
+            }
             else if (a == "--tiles") {
                 std::string t = next();
                 if (std::sscanf(t.c_str(), "%dx%d", &tile_w, &tile_h) != 2 || tile_w < 1 || tile_h < 1)
@@ -87,6 +146,7 @@ int main(int argc, char** argv) {
             }
             else throw UsageError("unknown argument '" + a + "' (see the comment at the top of tool.cpp)");
         }
+        if (!diff_a.empty()) return run_diff(diff_a, diff_b, tile_w, tile_h, spec);
         if (out_path.empty()) throw UsageError("--out FILE.exr is required");
         if (truth) return run_truth(spec, out_path, command, compare_path);
         spp = spec.options.get_int("spp", spp);

@@ -41,8 +41,11 @@ TEST(TruthRenderer, FurnaceIdentities) {
     d.options.set("lobes", "diffuse");
     TruthRender l = render_truth(d, load_environment("constant:1"));
     for (int x = 20; x < 300; x += 7)
-        for (int y = 20; y < 44; y += 5)
-            if (l.fine.coverage.at<float>(y, x) >= 1) EXPECT_NEAR(px(l.result.image, x, y)[2], 1.0, 2e-4) << x << "," << y;
+        for (int y = 20; y < 44; y += 5) {
+            if (l.fine.coverage.at<float>(y, x) >= 1) {
+                EXPECT_NEAR(px(l.result.image, x, y)[2], 1.0, 2e-4) << x << "," << y;
+            }
+        }
     std::printf("furnace centre pixels: r=0.5 %.5f, r=1 %.5f\n", px(m.result.image, 160, 31)[1], px(m.result.image, 288, 31)[1]);
 }
 
