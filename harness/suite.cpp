@@ -258,7 +258,8 @@ Suite load_suite(const std::string& name_or_path) {
             if (tj.contains("reference_ssaa")) proto.temporal.reference_ssaa = int(c.num(tj["reference_ssaa"], tw + ".reference_ssaa"));
             if (tj.contains("checks")) {
                 const json& cj = tj["checks"];
-                c.keys(cj, tw + ".checks", {"flicker", "variation_ratio", "flip_mean", "flicker_ratio", "flip_ratio"});
+                c.keys(cj, tw + ".checks", {"flicker", "variation_ratio", "flip_mean", "flicker_ratio", "flip_ratio", "truth_flicker",
+                                            "truth_flip_mean", "truth_flip_ratio"});
                 for (auto& [k, b] : cj.items()) {
                     std::string bw = tw + ".checks." + k;
                     c.keys(b, bw, {"min", "max"});

@@ -56,12 +56,15 @@ void register_truth_command(CLI::App& app, int& exit_code) {
     static std::string scene = "roughness_sweep", env, out;
     static std::vector<std::string> sets;
     static bool force = false;
+    static int frames = 0;
     cmd->add_option("--scene", scene, "Scene name (iblcheck list)")->capture_default_str();
     cmd->add_option("--env", env, "Environment: a spec (iblcheck list) or a path to your own .exr/.hdr")->required();
     cmd->add_option("--out", out, "Golden EXR to write (default: <reference key>.exr in the current folder); the "
                                   "sidecar is the same path with .json");
     cmd->add_option("--set", sets, "Option key=value (repeatable): material options, env_rotation, threads, "
                                    "truth_tolerance (the coarser level's pixel tolerance)");
+    cmd->add_option("--frames", frames, "Render the temporal truth: frames 0..N-1 (option frame) stacked vertically "
+                                        "in one golden, as the temporal suite reads it (reference/<key>__frames=N.exr)");
     cmd->add_flag("--force", force, "Overwrite existing output files");
     cmd->callback([&exit_code] {
         truth::GoldenRequest req;
@@ -73,7 +76,7 @@ void register_truth_command(CLI::App& app, int& exit_code) {
         // The file name from the golden store's key, with the environment as recorded (a path: its name).
         TestSpec keyed = req.spec;
         keyed.env = truth::portable_env_spec(env);
-        req.out_exr = out.empty() ? reference_key(keyed) + ".exr" : out;
+        req.out_exr = out.empty() ? reference_key(keyed) + (frames > 0 ? "__frames=" + std::to_string(frames) : "") + ".exr" : out;
         const fs::path json = fs::path(req.out_exr).replace_extension(".json");
         if (!force)
             for (const fs::path& p : {fs::path(req.out_exr), json})
@@ -83,6 +86,23 @@ void register_truth_command(CLI::App& app, int& exit_code) {
         for (auto& s : sets) req.command += " --set " + s;
         ProgressLine line(scene + " / " + keyed.env);
         req.progress = [&line](double f) { line(f); };
+        if (frames > 0) {
+            truth::SequenceRequest sr;
+            sr.spec = req.spec, sr.frames = frames, sr.bound_frames = {0, frames / 2}, sr.out_exr = req.out_exr;
+            sr.command = req.command + " --frames " + std::to_string(frames);
+            sr.progress = req.progress;
+            const nlohmann::json m = truth::write_truth_sequence_golden(sr);
+            line.done();
+            const auto& b = m["error_bound"];
+            fmt::print("wrote {} and {} ({} frames of {}x{}, {:.1f} s)\n", req.out_exr, json.string(), frames,
+                       m["width"].get<int>(), m["height"].get<int>(), m["time_s"].get<double>());
+            fmt::print("error bound (frames {} and {} against the finer level): relative RMSE <= {:.4f} %, mean FLIP <= {:.5f}, "
+                       "LDR FLIP <= {:.5f}\n",
+                       sr.bound_frames[0], sr.bound_frames[1], 100 * b["relative_rmse_max"].get<double>(),
+                       b["mean_flip_max"].get<double>(), b["mean_flip_ldr_max"].get<double>());
+            exit_code = kExitPass;
+            return;
+        }
         const truth::GoldenWritten g = truth::write_truth_golden(req);
         line.done();
         const auto& b = g.meta["error_bound"];

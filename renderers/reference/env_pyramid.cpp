@@ -58,6 +58,9 @@ EnvPyramid::EnvPyramid(const Environment& env) {
     for (int j = 0; j <= H_; ++j) row_s_[size_t(j)] = std::sin(j * kPi / H_);
     for (int i = 0; i <= W_; ++i) col_s_[size_t(i)] = std::sin(phi_of(double(i) / W_)), col_c_[size_t(i)] = std::cos(phi_of(double(i) / W_));
     taylor_ = 2 * kPi / W_ < 0.15 && kPi / H_ < 0.15; // series error < 0.15⁶/720 ≈ 2e-8
+    sub_cos_.assign(16, std::vector<double>(size_t(H_)));
+    for (int l = 0; l < 16; ++l)
+        for (int j = 0; j < H_; ++j) sub_cos_[size_t(l)][size_t(j)] = std::cos(subcell_radius(j, 1 << l, 0));
     w_.push_back(W_), h_.push_back(H_);
     while (w_.back() > 2 || h_.back() > 1) w_.push_back((w_.back() + 1) / 2), h_.push_back((h_.back() + 1) / 2);
     cells_.resize(w_.size());
@@ -112,6 +115,7 @@ void EnvPyramid::build_level0(const cv::Mat&) {
             for (double fu : {0.0, 1.0})
                 for (double z : {zt, zb}) min_cos = std::min(min_cos, dot(g, to_world(env_dir(phi_of((i + fu) / W_), z))));
             c.cos_radius = float(std::cos(std::min(kPi, std::acos(std::clamp(min_cos, -1.0, 1.0)) * 1.01 + 1e-7)));
+            c.radius = float(std::acos(std::clamp(double(c.cos_radius), -1.0, 1.0)));
         }
     }
 }
@@ -212,6 +216,7 @@ void EnvPyramid::build_level(int k) {
             double rad = std::acos(std::clamp(min_cos, -1.0, 1.0)) * 1.01 + 1e-7;
             if (p1 - p0 > kPi / 2) rad = kPi; // very wide cells: no tight bound needed
             c.cos_radius = float(std::cos(std::min(kPi, rad)));
+            c.radius = float(std::acos(std::clamp(double(c.cos_radius), -1.0, 1.0)));
             const double cl = std::sqrt(cen[0] * cen[0] + cen[1] * cen[1] + cen[2] * cen[2]);
             const V3 cc = cl > 0 ? V3{cen[0] / cl, cen[1] / cl, cen[2] / cl} : g;
             c.c[0] = float(cc.x), c.c[1] = float(cc.y), c.c[2] = float(cc.z);
@@ -251,23 +256,41 @@ void EnvPyramid::radiance(V3 dir, double rgb[3]) const {
     bilinear_equirect(data_.data(), W_, H_, size_t(W_) * 3, u, v, rgb);
 }
 
+// sin/cos of a small angle d by its series (|d| < 0.15: error < 2e-8), added to a tabulated edge angle.
+namespace {
+inline void small_sc(double d, double& s, double& c) {
+    const double d2 = d * d;
+    s = d * (1 - d2 / 6 * (1 - d2 / 20));
+    c = 1 - d2 / 2 * (1 - d2 / 12 * (1 - d2 / 30));
+}
+} // namespace
+
+void EnvPyramid::phi_sc(int i, double fu, double& sp, double& cp) const {
+    if (!taylor_) {
+        const double phi = phi_of((i + fu) / W_);
+        sp = std::sin(phi), cp = std::cos(phi);
+        return;
+    }
+    double s, c;
+    small_sc(fu * 2 * kPi / W_, s, c);
+    sp = col_s_[size_t(i)] * c + col_c_[size_t(i)] * s, cp = col_c_[size_t(i)] * c - col_s_[size_t(i)] * s;
+}
+
+void EnvPyramid::theta_sc(int j, double ft, double& st, double& ct) const {
+    if (!taylor_) {
+        const double th = (j + ft) * kPi / H_;
+        st = std::sin(th), ct = std::cos(th);
+        return;
+    }
+    double s, c;
+    small_sc(ft * kPi / H_, s, c);
+    st = row_s_[size_t(j)] * c + row_z_[size_t(j)] * s, ct = row_z_[size_t(j)] * c - row_s_[size_t(j)] * s;
+}
+
 V3 EnvPyramid::dir_in_texel(int i, double fu, int j, double ft, double* sin_theta) const {
     double sp, cp, st, ct;
-    if (taylor_) {
-        auto sc = [](double d, double& s, double& c) {
-            const double d2 = d * d;
-            s = d * (1 - d2 / 6 * (1 - d2 / 20));
-            c = 1 - d2 / 2 * (1 - d2 / 12 * (1 - d2 / 30));
-        };
-        double s, c;
-        sc(fu * 2 * kPi / W_, s, c);
-        sp = col_s_[size_t(i)] * c + col_c_[size_t(i)] * s, cp = col_c_[size_t(i)] * c - col_s_[size_t(i)] * s;
-        sc(ft * kPi / H_, s, c);
-        st = row_s_[size_t(j)] * c + row_z_[size_t(j)] * s, ct = row_z_[size_t(j)] * c - row_s_[size_t(j)] * s;
-    } else {
-        const double phi = phi_of((i + fu) / W_), th = (j + ft) * kPi / H_;
-        sp = std::sin(phi), cp = std::cos(phi), st = std::sin(th), ct = std::cos(th);
-    }
+    phi_sc(i, fu, sp, cp);
+    theta_sc(j, ft, st, ct);
     if (sin_theta) *sin_theta = st;
     return to_world(V3{st * sp, ct, -st * cp});
 }
@@ -284,13 +307,36 @@ void EnvPyramid::subcell(int i, int j, int n, int a, int b, V3& dir, double& ome
 void EnvPyramid::subcell_gauss(int i, int j, int n, int a, int b, V3 dir[4], double wL[4][3]) const {
     const double g = 0.5 / std::sqrt(3.0);
     const double w0 = 0.25 * (2 * kPi / (double(W_) * n)) * (kPi / (double(H_) * n));
+    // The rule's nodes share two columns (fu) and two rows (ft): their sines and cosines once each.
+    const double fu[2] = {(a + 0.5 - g) / n, (a + 0.5 + g) / n}, ft[2] = {(b + 0.5 - g) / n, (b + 0.5 + g) / n};
+    double sp[2], cp[2], st[2], ct[2];
+    for (int k = 0; k < 2; ++k) phi_sc(i, fu[k], sp[k], cp[k]), theta_sc(j, ft[k], st[k], ct[k]);
+    if (n < 2) { // a whole texel: its nodes straddle the texel centre, the general filter
+        for (int k = 0; k < 4; ++k) {
+            const int kx = k & 1, ky = k >> 1;
+            dir[k] = to_world(V3{st[ky] * sp[kx], ct[ky], -st[ky] * cp[kx]});
+            double L[3];
+            bilinear_equirect(data_.data(), W_, H_, size_t(W_) * 3, (i + fu[kx]) / W_, (j + ft[ky]) / H_, L);
+            for (int q = 0; q < 3; ++q) wL[k][q] = w0 * st[ky] * L[q];
+        }
+        return;
+    }
+    // The bilinear filter (environment.h): texel centres at half-integers, so a sub-cell of a split texel
+    // (n ≥ 2) lies in one quadrant, between the same four texels — the texel and its neighbours toward
+    // that quadrant (u wraps, v clamps), with weights fx = fu ± 1/2, fy = ft ± 1/2.
+    const bool left = 2 * a < n, up = 2 * b < n;
+    const int x0 = left ? (i == 0 ? W_ - 1 : i - 1) : i, x1 = x0 + 1 == W_ ? 0 : x0 + 1;
+    const int y0 = std::clamp(up ? j - 1 : j, 0, H_ - 1), y1 = std::clamp(up ? j : j + 1, 0, H_ - 1);
+    const float *r0 = &data_[size_t(y0) * W_ * 3], *r1 = &data_[size_t(y1) * W_ * 3];
+    const float *p00 = r0 + 3 * x0, *p10 = r0 + 3 * x1, *p01 = r1 + 3 * x0, *p11 = r1 + 3 * x1;
     for (int k = 0; k < 4; ++k) {
-        const double fu = (a + 0.5 + ((k & 1) ? g : -g)) / n, ft = (b + 0.5 + ((k >> 1) ? g : -g)) / n;
-        double st;
-        dir[k] = dir_in_texel(i, fu, j, ft, &st);
-        double L[3];
-        bilinear_equirect(data_.data(), W_, H_, size_t(W_) * 3, (i + fu) / W_, (j + ft) / H_, L);
-        for (int q = 0; q < 3; ++q) wL[k][q] = w0 * st * L[q];
+        const int kx = k & 1, ky = k >> 1;
+        dir[k] = to_world(V3{st[ky] * sp[kx], ct[ky], -st[ky] * cp[kx]});
+        const double fx = left ? fu[kx] + 0.5 : fu[kx] - 0.5, fy = up ? ft[ky] + 0.5 : ft[ky] - 0.5;
+        for (int q = 0; q < 3; ++q) {
+            const double L = (1 - fy) * ((1 - fx) * p00[q] + fx * p10[q]) + fy * ((1 - fx) * p01[q] + fx * p11[q]);
+            wL[k][q] = w0 * st[ky] * L;
+        }
     }
 }
 

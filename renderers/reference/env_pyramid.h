@@ -33,6 +33,7 @@ struct EnvCell {
     int np;            // the Cholesky factor of cov on c's tangent plane; 1 point (c) when cov vanishes
     float g[3];        // geometric centre direction (unit)
     float cos_radius;  // cos of the largest angle from g to the cell's edge
+    float radius;      // that angle (acos of cos_radius, kept: the quadrature's guard compares angles)
     float lo[3], hi[3]; // range of the bilinear radiance inside the cell (per channel)
 };
 
@@ -60,8 +61,10 @@ class EnvPyramid {
     // The 2x2 Gauss–Legendre rule of a sub-texel cell in (u, θ) (the bilinear radiance is smooth inside
     // a quarter texel): its nodes' directions and radiance × weight (∫ ≈ Σ f(dir_k)·wL_k).
     void subcell_gauss(int i, int j, int n, int a, int b, V3 dir[4], double wL[4][3]) const;
-    // Angular radius bound of a sub-texel cell (as subcell()'s arguments).
+    // Angular radius bound of a sub-texel cell (as subcell()'s arguments), and its cosine (tabulated per
+    // row and sub-level: the quadrature asks for it at every sub-texel cell).
     double subcell_radius(int j, int n, int b) const;
+    double subcell_cos_radius(int j, int n) const { return sub_cos_[size_t(__builtin_ctz(unsigned(n)))][size_t(j)]; }
     // A cell as a rectangle in the tangent plane at its solid-angle centre g: ex along φ, ey along θ
     // (unit, world), half-extents hx = sin θ_g·Δφ/2 and hy = Δθ/2 (level ≥ 0: (level, i, j); sub-texel
     // level −s: texel (i, j), sub-cell (a, b)). Used to clip a cell at the horizon.
@@ -95,6 +98,10 @@ class EnvPyramid {
     std::vector<std::vector<EnvCell>> cells_;
     std::vector<double> texel_omega_, row_z_; // row_z_: cos θ at row edges (H + 1)
     std::vector<double> row_s_, col_s_, col_c_; // sin θ at row edges; sin φ, cos φ at column edges
+    std::vector<std::vector<double>> sub_cos_;  // [log2 n][row]: cos of subcell_radius
+    // sin and cos of φ at fraction fu across texel column i, and of θ at fraction ft down texel row j.
+    void phi_sc(int i, double fu, double& s, double& c) const;
+    void theta_sc(int j, double ft, double& s, double& c) const;
     bool taylor_ = true;                        // texels small enough for the angle-sum series
 };
 

@@ -65,12 +65,10 @@ TEST(Footprint, IntegralMatchesBruteForceInsideAndOnTheRim) {
     FootprintParams p;
     p.tolerance = 1e-6;
     double worst = 0;
-    for (auto [px, py] : {std::pair{20, 20}, {33, 15}, {37, 20}, {5, 9}, {20, 3}, {7, 7}, {34, 33}}) {
+    for (auto [px, py] : {std::pair{20, 20}, {33, 15}, {37, 20}, {6, 10}, {20, 3}, {8, 8}, {32, 32}}) {
         const PixelIntegral pi = integrate_pixel(d, px, py, g, nullptr, p);
-        double bx, by;
-        const double area = brute_area(d, px, py, px + 1, py + 1, bx, by, 10);
         EXPECT_NEAR(pi.coverage, disc_rect_area(d, px, py, px + 1, py + 1), 1e-12);
-        ASSERT_GT(area, 0);
+        ASSERT_GT(pi.coverage, 0) << "pixel " << px << "," << py << " misses the disc";
         // Reference: 4000² midpoint grid of the integrand inside the disc.
         const int n = 4000;
         double ref[3] = {0, 0, 0};

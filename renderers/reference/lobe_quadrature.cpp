@@ -121,7 +121,7 @@ struct Integrand {
         } else {
             const int n = 1 << -level;
             g = env.dir_in_texel(i, (a + 0.5) / n, j, (b + 0.5) / n);
-            cr = std::cos(env.subcell_radius(j, n, b));
+            cr = env.subcell_cos_radius(j, n);
             env.subcell_gauss(i, j, n, a, b, pts, wL);
             for (int k = 0; k < 4; ++k)
                 for (int q = 0; q < 3; ++q) L[q] += wL[k][q];
@@ -171,7 +171,7 @@ struct Integrand {
             const EnvCell& c = env.cell(level, i, j);
             g = {c.g[0], c.g[1], c.g[2]};
             if (c.cos_radius >= cos_guard_w) return false; // radius ≤ κ·w: resolved wherever it is
-            radius = std::acos(std::clamp(double(c.cos_radius), -1.0, 1.0));
+            radius = c.radius;
         } else {
             const int n = 1 << -level;
             radius = env.subcell_radius(j, n, b);

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <filesystem>
 #include <chrono>
 #include <cmath>
 #include <thread>
@@ -696,7 +697,8 @@ ReferenceRender render_reference_full(const TestSpec& spec, const Environment* e
         {"mis_compensation", mis_compensation},
         {"env", {{"spec", env.spec.empty() ? spec.env : env.spec},
                  {"content_hash", env.content_hash},
-                 {"source_path", env.source_path},
+                 // the file's name, not its path: provenance holds no machine paths (issue 15)
+                 {"source_file", std::filesystem::path(env.source_path).filename().string()},
                  {"width", env.equirect.cols},
                  {"height", env.equirect.rows},
                  {"negatives_clamped", env.negatives_clamped},

@@ -1,12 +1,15 @@
 // iblcheck_reference_tool: renders one reference image (a golden) and its metadata.
 //   iblcheck_reference_tool --scene S --env E [--spp N] [--seed K] [--threads T] [--set key=value]...
 //                           --out FILE.exr [--meta FILE.json] [--noise-floor [--tiles WxH]] [--command "..."]
+//   iblcheck_reference_tool --truth --scene S --env E [--set key=value]... [--frames N] --out FILE.exr [--compare OLD.exr]
+//   iblcheck_reference_tool --diff A.exr B.exr [--tiles WxH] [--scene S]
 // --noise-floor renders a second image with seed K+1 and records the relative RMSE between the two
 // (reference.h, measure_noise_floor); the golden written is the seed-K image. --tiles WxH also prints the
 // noise floor per WxH tile (48x48 = one sphere of the roughness sweep), to see where the noise is.
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <ctime>
 #include <fstream>
 #include <iostream>
@@ -106,6 +109,24 @@ static int run_diff(const std::string& a_path, const std::string& b_path, int ti
     return 0;
 }
 
+// --truth --frames N: the temporal truth (truth_sequence.h) as one golden (frames stacked vertically).
+static int run_truth_sequence(const TestSpec& spec, int frames, const std::string& out_path, const std::string& command) {
+    truth::SequenceRequest req;
+    req.spec = spec;
+    req.frames = frames;
+    req.bound_frames = {0, frames / 2};
+    req.out_exr = out_path;
+    req.command = command;
+    const nlohmann::json m = truth::write_truth_sequence_golden(req);
+    const auto& b = m["error_bound"];
+    std::printf("%s: %d frames of %dx%d, time=%.1fs bound (frames %d, %d vs finer): rel_rmse<=%.4f%% mean_flip<=%.5f "
+                "ldr_flip<=%.5f\n",
+                out_path.c_str(), frames, m["width"].get<int>(), m["height"].get<int>(), m["time_s"].get<double>(),
+                req.bound_frames[0], req.bound_frames[1], 100 * b["relative_rmse_max"].get<double>(),
+                b["mean_flip_max"].get<double>(), b["mean_flip_ldr_max"].get<double>());
+    return 0;
+}
+
 int main(int argc, char** argv) {
     try {
         TestSpec spec;
@@ -113,7 +134,7 @@ int main(int argc, char** argv) {
         std::string out_path, meta_path, command;
         bool noise = false, truth = false;
         std::string compare_path, diff_a, diff_b;
-        int tile_w = 0, tile_h = 0;
+        int tile_w = 0, tile_h = 0, frames = 0;
         int spp = kReferenceDefaultSpp, seed = 0;
         for (int i = 1; i < argc; ++i) {
             std::string a = argv[i];
@@ -134,6 +155,7 @@ int main(int argc, char** argv) {
             else if (a == "--noise-floor") noise = true;
             else if (a == "--command") command = next();
             else if (a == "--truth") truth = true;
+            else if (a == "--frames") frames = std::stoi(next());
             else if (a == "--compare") compare_path = next();
             else if (a == "--diff") {
                 diff_a = next();
@@ -148,6 +170,7 @@ int main(int argc, char** argv) {
         }
         if (!diff_a.empty()) return run_diff(diff_a, diff_b, tile_w, tile_h, spec);
         if (out_path.empty()) throw UsageError("--out FILE.exr is required");
+        if (truth && frames > 0) return run_truth_sequence(spec, frames, out_path, command);
         if (truth) return run_truth(spec, out_path, command, compare_path);
         spp = spec.options.get_int("spp", spp);
         seed = spec.options.get_int("seed", seed);
@@ -207,7 +230,6 @@ int main(int argc, char** argv) {
             meta["provenance"] = r.provenance;
         }
         double time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        write_exr(out_path, image);
         Environment env = load_environment(spec.env);
         char date[64];
         std::time_t now = std::time(nullptr);
@@ -222,13 +244,13 @@ int main(int argc, char** argv) {
         meta["time_s"] = time_s;
         meta["command"] = command;
         meta["date"] = date;
-        meta["image"] = out_path;
+        meta["image"] = std::filesystem::path(out_path).filename().string(); // beside the sidecar: no machine path
+        meta["env"]["spec"] = truth::portable_env_spec(spec.env);
         meta["channels"] = "R,G,B float32 linear";
-        if (!meta_path.empty()) {
-            std::ofstream f(meta_path);
-            f << meta.dump(2) << "\n";
-            if (!f) throw InputError("cannot write " + meta_path);
-        }
+        if (!meta_path.empty() && std::filesystem::path(meta_path) != std::filesystem::path(out_path).replace_extension(".json"))
+            throw UsageError("--meta must be the image's path with .json (" +
+                             std::filesystem::path(out_path).replace_extension(".json").string() + ")");
+        truth::write_golden_files(out_path, image, meta);
         std::printf("%s: %dx%d spp=%d time=%.1fs%s\n", out_path.c_str(), image.cols, image.rows, spp, time_s,
                     noise ? (" noise_floor=" + std::to_string(meta["noise_floor"]["relative_rmse"].get<double>())).c_str()
                           : "");

@@ -1,6 +1,6 @@
 // iblcheck_truth_convergence: the quadrature truth's error against time (CONVERGENCE.md's table).
 //   iblcheck_truth_convergence --scene S --env E [--set key=value]... [--threads T] [--per-sphere]
-//                              --level KEY=V,KEY=V... [--level ...]   (keys: pixel, env, table, kappa, floor)
+//                              --level KEY=V,KEY=V... [--level ...]   (keys: pixel, env, table, kappa, floor, bound)
 //                              [--finer N] [--save PREFIX] [--against FINEST.exr] [--only SUBSTRING]...
 // Renders each --level (an accuracy; unset keys keep TruthAccuracy's defaults), then N (default 2) successive
 // finer() levels of the last one; the finest is the solution every level is measured against: relative
@@ -45,7 +45,8 @@ TruthAccuracy parse_level(const std::string& text) {
         else if (k == "table") a.table_tolerance = v;
         else if (k == "kappa") a.kappa = v;
         else if (k == "floor") a.floor = v;
-        else throw UsageError("--level: unknown key '" + k + "' (pixel, env, table, kappa, floor)");
+        else if (k == "bound") a.bound_depth = int(v);
+        else throw UsageError("--level: unknown key '" + k + "' (pixel, env, table, kappa, floor, bound)");
     }
     return a;
 }

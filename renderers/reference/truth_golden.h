@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "renderers/reference/truth_renderer.h"
+#include "renderers/reference/truth_sequence.h"
 
 namespace iblcheck::truth {
 
@@ -28,6 +29,24 @@ struct GoldenWritten {
 };
 
 GoldenWritten write_truth_golden(const GoldenRequest& request);
+
+// The temporal truth as one golden: the frames stacked vertically in one EXR (frame f is rows f·H ..
+// (f+1)·H − 1), the sidecar with the frame count and size, the accuracy, and the bound on the bound
+// frames (relative RMSE, worst pixel, HDR-FLIP, and LDR-FLIP after the display transform — the temporal
+// suite's own metric — each frame against its finer render). reference_sequence_key names it.
+struct SequenceRequest {
+    TestSpec spec;       // scene, env (loaded from spec.env), options (frame is set per frame)
+    int frames = 32;
+    std::vector<int> bound_frames = {0, 16};
+    std::string out_exr;
+    std::string command;
+    Progress progress;
+};
+nlohmann::json write_truth_sequence_golden(const SequenceRequest& request);
+
+// A golden's EXR and its JSON sidecar (same path, .json), each through a temporary file renamed into
+// place, the sidecar first; an EXR whose pixels are bit-identical to the new ones is not rewritten.
+void write_golden_files(const std::string& exr_path, const cv::Mat& image, const nlohmann::json& meta);
 
 // The environment as recorded in a sidecar: its spec, but a file path reduced to its file name (no
 // absolute machine paths in goldens), with the content hash that identifies it.

@@ -17,15 +17,19 @@
 namespace iblcheck::truth {
 
 // One refinement level. finer() tightens every control (the bound is the difference between a level
-// and its finer one, so the finer one must be finer in every error source): tolerances / 4 (the
-// table's / 2), guard / 2.
+// and its finer one, so the finer one must be finer in every error source): tolerances / 2, guard / √2.
 struct TruthAccuracy {
     double pixel_tolerance = 1e-3;   // footprint.h, relative per pixel (table and mirror lookups are cheap)
-    double env_tolerance = 5e-4;     // lobe_quadrature.h, relative per shading point (table node)
+    double env_tolerance = 2.5e-4;   // lobe_quadrature.h, relative per shading point (table node)
     double table_tolerance = 2e-2;   // normal_table.h, the bilinear error that splits a cell (the leaves
                                      // interpolate biquadratically: their error is an order smaller)
     double floor = 1e-3;             // of every tolerance, × the environment's mean radiance
-    double kappa = 1;                // lobe guards (quadrature and table), × the lobe's width
+    double kappa = 2;                // lobe guards (quadrature and table), × the lobe's width (2 instead of 1:
+                                     // 21 % less time, the same error: CONVERGENCE.md)
+    int bound_depth = 6;             // footprint.h: the variation bound splits squares down to 2^-depth px
+    // The temporal sequences' accuracy: a bumped sphere's pixels average a wide cone of normals, so every
+    // control is looser (measured in CONVERGENCE.md, "The temporal truth").
+    static TruthAccuracy temporal();
     TruthAccuracy finer() const;
     nlohmann::json json() const;
 };
@@ -66,9 +70,14 @@ struct TruthRender {
     TruthImage coarse, fine;
     TruthBound bound;
 };
+// Smooth spheres with a glossy lobe narrower than this (roughness below ~0.045) are refused (see
+// render_truth): the Monte Carlo integrator renders them.
+inline constexpr double kNearMirrorAlpha = 2e-3;
+
 // spec.options: the scene's options, env_rotation, lobes, threads, truth_tolerance (the coarse level's
-// env and pixel tolerances; default 1e-3). Throws UsageError for a perspective camera or overlapping
-// silhouettes (the quadrature integrates each disc's footprint on its own).
+// pixel tolerance, default 1e-3; its env tolerance is a quarter of it). Throws UsageError for a
+// perspective camera, overlapping silhouettes (the quadrature integrates each disc's footprint on its
+// own) or a near-mirror lobe on a smooth sphere (kNearMirrorAlpha).
 TruthRender render_truth(const TestSpec& spec, const Environment& env, const Progress& progress = {});
 
 // One level (tests, measurements). env_key identifies the environment and its rotation (the normal

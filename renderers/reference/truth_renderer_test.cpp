@@ -62,13 +62,26 @@ TEST(TruthRenderer, ConstantEnvironmentClosedForms) {
         const V3 n = sv.normal(x, y);
         out[0] = out[1] = out[2] = model::f_schlick(0.8, std::max(dot(n, sv.view()), kMinNdotV));
     };
-    FootprintParams fp;
-    fp.tolerance = 1e-7;
-    for (int y = 0; y < 24; y += 3)
-        for (int x = 0; x < 24; ++x) {
-            const PixelIntegral pi = integrate_pixel(sv.disc(), x, y, F, nullptr, fp);
-            ASSERT_NEAR(px(r.result.image, x, y)[0], 0.5 * pi.rgb[0], 2e-4 * (0.5 * pi.rgb[0]) + 1e-7) << x << "," << y;
-        }
+    // Independently: a 2000x2000 midpoint grid over the pixel (F's square-root singularity at the rim is
+    // integrable: the grid's error there is ~1e-5 of the pixel), on the centre, the rim and in between.
+    auto brute = [&](int x, int y) {
+        const int n = 2000;
+        double sum = 0;
+        for (int b = 0; b < n; ++b)
+            for (int a = 0; a < n; ++a) {
+                const double xx = x + (a + 0.5) / n, yy = y + (b + 0.5) / n;
+                const Disc& d = sv.disc();
+                if ((xx - d.cx) * (xx - d.cx) + (yy - d.cy) * (yy - d.cy) > d.r * d.r) continue;
+                double f[3];
+                F(xx, yy, f);
+                sum += f[0];
+            }
+        return sum / (double(n) * n);
+    };
+    for (auto [x, y] : {std::pair{4, 3}, {12, 12}, {1, 12}, {12, 1}, {20, 6}, {7, 21}, {16, 2}}) {
+        const double want = 0.5 * brute(x, y);
+        EXPECT_NEAR(px(r.result.image, x, y)[0], want, 3e-4 * want + 2e-6) << x << "," << y;
+    }
     TestSpec d = spec_of("sphere", "constant:0.5", 24, 24);
     d.options.set("lobes", "diffuse"), d.options.set("base_color", "0.6");
     TruthRender l = render_truth(d, load_environment("constant:0.5"));
