@@ -24,6 +24,11 @@ fi
 cmake --build "$BUILD_DIR" -j2 --target iblcheck_reference_tool >/dev/null
 TOOL=$(find "$BUILD_DIR" -name iblcheck_reference_tool -type f -perm -u+x | head -1)
 mkdir -p "$OUT"
+# The committed goldens, kept aside to state how far each new one is from it (mean FLIP, relative RMSE).
+OLD=$(mktemp -d)
+trap 'rm -rf "$OLD"' EXIT
+cp "$OUT"/*.exr "$OLD"/ 2>/dev/null || true
+compare_old() { [[ -f "$OLD/$1.exr" ]] && echo --compare && echo "$OLD/$1.exr"; return 0; }
 echo "[goldens] expected: $EXPECTED_TIME"
 start=$(date +%s)
 name_of() { # scene env [key=value...]: harness/golden_store.h's reference_key (':' '/' -> '-'; material
@@ -40,7 +45,8 @@ truth() { # scene env [key=value...]: the quadrature truth
   name=$(name_of "$scene" "$env" "$@")
   t0=$(date +%s)
   mapfile -t sets < <(sets_of "$@")
-  "$TOOL" --truth --scene "$scene" --env "$env" "${sets[@]}" --out "$OUT/$name.exr" \
+  mapfile -t cmp < <(compare_old "$name")
+  "$TOOL" --truth --scene "$scene" --env "$env" "${sets[@]}" --out "$OUT/$name.exr" "${cmp[@]}" \
     --command "scripts/regenerate_reference_goldens.sh"
   echo "[goldens] $name: $(( $(date +%s) - t0 )) s"
 }
@@ -52,6 +58,7 @@ monte_carlo() { # scene env spp [key=value...]: the Monte Carlo integrator (seed
   mapfile -t sets < <(sets_of "$@")
   "$TOOL" --scene "$scene" --env "$env" --spp "$spp" --seed 0 --noise-floor "${sets[@]}" \
     --out "$OUT/$name.exr" --meta "$OUT/$name.json" --command "scripts/regenerate_reference_goldens.sh (spp=$spp)"
+  if [[ -f "$OLD/$name.exr" ]]; then "$TOOL" --diff "$OUT/$name.exr" "$OLD/$name.exr" | head -1; fi
   echo "[goldens] $name: $(( $(date +%s) - t0 )) s"
 }
 truth furnace constant:1

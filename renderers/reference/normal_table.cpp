@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <cstdlib>
 #include <mutex>
 #include <thread>
 
@@ -43,9 +42,8 @@ struct NormalTable::Builder {
         // Grazing normals cover little of the image (∝ n·v): their quadrature may be as much looser. Nodes
         // of cells smaller than a pixel's footprint enter a pixel (footprint/s)² at a time, their errors
         // (each from its own refinement) averaging as footprint/s: they may be as much looser too.
-        static const bool no_graze = std::getenv("IBLCHECK_EXP_NO_GRAZE"), no_small = std::getenv("IBLCHECK_EXP_NO_SMALL");
-        if (!no_graze) q.tolerance /= std::clamp(dot(n, t.v_) + tp.weight_offset, 0.05, 1.0);
-        if (!no_small && s > 0 && s < tp.footprint) q.tolerance *= tp.footprint / s;
+        q.tolerance /= std::clamp(dot(n, t.v_) + tp.weight_offset, 0.05, 1.0);
+        if (s > 0 && s < tp.footprint) q.tolerance *= tp.footprint / s;
         shade(env, lobe, shading_point(n, t.v_, lobe), q, rgb, &st);
         ++nodes, evals += st.evaluations;
         for (int q = 0; q < 3; ++q) out[q] = float(rgb[q]);
