@@ -113,6 +113,23 @@ std::vector<Golden> GoldenStore::baselines(const std::string& test_name) const {
     return out;
 }
 
+fs::path GoldenStore::reference_sequence_path(const TestSpec& spec, int frames) const {
+    return root_ / "reference" / (reference_key(spec) + "__frames=" + std::to_string(frames) + ".exr");
+}
+
+std::optional<Golden> GoldenStore::reference_sequence(const TestSpec& spec, int frames, std::vector<cv::Mat>& out) const {
+    out.clear();
+    const fs::path p = reference_sequence_path(spec, frames);
+    if (!fs::exists(p)) return std::nullopt;
+    Golden g = load_golden(p, "");
+    if (frames < 1 || g.image.rows % frames != 0)
+        throw InputError(p.string() + ": " + std::to_string(g.image.rows) + " rows are not " + std::to_string(frames) +
+                         " stacked frames");
+    const int h = g.image.rows / frames;
+    for (int f = 0; f < frames; ++f) out.push_back(g.image.rowRange(f * h, (f + 1) * h).clone());
+    return g;
+}
+
 std::optional<Golden> GoldenStore::reference(const TestSpec& spec) const {
     fs::path p = reference_path(spec);
     if (!fs::exists(p)) return std::nullopt;

@@ -38,6 +38,12 @@ class GoldenStore {
     std::optional<Golden> reference(const TestSpec& spec) const;
     std::filesystem::path baseline_path(const std::string& test_name, const std::string& label = "") const;
     std::filesystem::path reference_path(const TestSpec& spec) const;
+    // The temporal truth of a sequence of `frames` frames: reference/<key>__frames=N.exr, the frames
+    // stacked vertically (renderers/reference/truth_golden.h), split into frames; nullopt when absent.
+    // Throws InputError naming the file when it is corrupt, has no sidecar or NaN/Inf pixels, or its
+    // height is not a multiple of `frames`.
+    std::optional<Golden> reference_sequence(const TestSpec& spec, int frames, std::vector<cv::Mat>& out) const;
+    std::filesystem::path reference_sequence_path(const TestSpec& spec, int frames) const;
 
     // Atomically writes image + sidecar (each through a temporary file renamed into place).
     // Throws InputError naming the path when it cannot.

@@ -296,7 +296,7 @@ json run_test(const TestCase& tc, Worker& w, const GoldenStore& store, const fs:
                 add(c.verdict, c.message.empty() ? "" : "accuracy: " + c.message);
             }
         if (tc.temporal.frames > 0) {
-            TemporalOutcome t = run_temporal(tc, w, art.dir, art.rel, flip_threads);
+            TemporalOutcome t = run_temporal(tc, w, store, art.dir, art.rel, flip_threads);
             r["temporal"] = t.json;
             for (const Check& k : t.checks) add(k.status, k.message.empty() ? "" : "temporal: " + k.message);
         }

@@ -197,7 +197,8 @@ TemporalSpec parse_temporal(const Ctx& c, const json& tj, const std::string& tw)
         temporal.reference_options = c.options(tj["reference_options"], tw + ".reference_options");
     if (tj.contains("checks")) {
         const json& cj = tj["checks"];
-        c.keys(cj, tw + ".checks", {"flicker", "variation_ratio", "flip_mean", "flicker_ratio", "flip_ratio"});
+        c.keys(cj, tw + ".checks", {"flicker", "variation_ratio", "flip_mean", "flicker_ratio", "flip_ratio", "truth_flicker",
+                                    "truth_flip_mean", "truth_flip_ratio"});
         for (auto& [k, b] : cj.items()) {
             std::string bw = tw + ".checks." + k;
             c.keys(b, bw, {"min", "max"});

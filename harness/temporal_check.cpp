@@ -2,6 +2,9 @@
 
 #include <fmt/core.h>
 
+#include <cmath>
+
+#include "metrics/display_transform.h"
 #include "metrics/flip.h"
 #include "metrics/image_io.h"
 #include "metrics/temporal.h"
@@ -29,8 +32,8 @@ SequenceScore score_sequence(const std::vector<cv::Mat>& test, const std::vector
 }
 } // namespace
 
-TemporalOutcome run_temporal(const TestCase& tc, Worker& w, const fs::path& img_dir, const std::string& rel_dir,
-                             int flip_threads) {
+TemporalOutcome run_temporal(const TestCase& tc, Worker& w, const GoldenStore& store, const fs::path& img_dir,
+                             const std::string& rel_dir, int flip_threads) {
     const TemporalSpec& ts = tc.temporal;
     TestSpec off = without_specular_aa(tc.spec), ref = temporal_reference_spec(tc);
     const auto& test_frames = w.sequence(tc.spec, ts.frames);
@@ -48,9 +51,47 @@ TemporalOutcome run_temporal(const TestCase& tc, Worker& w, const fs::path& img_
          {"flicker_ratio", so.flicker > 0 ? st.flicker / so.flicker : 1.0},
          {"flip_ratio", so.flip_mean > 0 ? st.flip_mean / so.flip_mean : 1.0},
          {"reference", {{"method", ref.method}, {"options", ref.options.canonical()}}}};
+    // The truth: the same scene's quadrature truth, frame by frame (no method-specific options).
+    TestSpec truth_spec;
+    truth_spec.scene = tc.spec.scene, truth_spec.env = tc.spec.env, truth_spec.width = tc.spec.width,
+    truth_spec.height = tc.spec.height;
+    for (const char* k : {"roughness", "metallic", "base_color", "env_rotation"})
+        if (tc.spec.options.has(k)) truth_spec.options.set(k, tc.spec.options.get_string(k, ""));
+    std::vector<cv::Mat> truth_linear;
+    const std::optional<Golden> truth = store.reference_sequence(truth_spec, ts.frames, truth_linear);
+    if (truth) {
+        std::vector<cv::Mat> truth_frames;
+        for (const cv::Mat& m : truth_linear) truth_frames.push_back(display_transform(m));
+        const SequenceScore tt = score_sequence(test_frames, truth_frames, flip_threads);
+        const SequenceScore to = score_sequence(off_frames, truth_frames, flip_threads);
+        const SequenceScore tr = score_sequence(ref_frames, truth_frames, flip_threads);
+        j["truth"] = {{"golden", store.relative(truth->image_path)},
+                      {"error_bound", truth->provenance.value("error_bound", json())},
+                      {"flicker", tt.flicker},
+                      {"variation_ratio", tt.variation_ratio},
+                      {"flip_mean", tt.flip_mean},
+                      {"off", {{"flicker", to.flicker}, {"variation_ratio", to.variation_ratio}, {"flip_mean", to.flip_mean}}},
+                      {"reference", {{"flicker", tr.flicker}, {"variation_ratio", tr.variation_ratio}, {"flip_mean", tr.flip_mean}}},
+                      {"flip_ratio", to.flip_mean > 0 ? tt.flip_mean / to.flip_mean : 1.0}};
+        j["truth_flicker"] = tt.flicker;
+        j["truth_flip_mean"] = tt.flip_mean;
+        j["truth_flip_ratio"] = j["truth"]["flip_ratio"];
+    } else {
+        j["truth"] = {{"missing", store.relative(store.reference_sequence_path(truth_spec, ts.frames))}};
+    }
     j["checks"] = json::array();
     for (auto& [metric, bound] : ts.checks) {
-        Check c = judge_bound("temporal." + metric, j[metric].get<double>(), bound);
+        Check c;
+        if (!j.contains(metric)) { // a truth check without the truth golden
+            c.metric = "temporal." + metric;
+            c.value = std::nan("");
+            c.min = bound.min, c.max = bound.max;
+            c.status = Verdict::missing_golden;
+            c.message = "no temporal truth " + j["truth"]["missing"].get<std::string>() +
+                        " (scripts/regenerate_reference_goldens.sh writes it)";
+        } else {
+            c = judge_bound("temporal." + metric, j[metric].get<double>(), bound);
+        }
         j["checks"].push_back(to_json(c));
         out.checks.push_back(std::move(c));
     }

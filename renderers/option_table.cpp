@@ -57,7 +57,10 @@ const std::vector<OptionInfo>& option_catalog() {
         {"min_lod", "0", ">=0", "sampled", "", "lowest mip a sample may read"},
         {"diffuse_roughness", "0.9", "0..1", "sampled", "", "roughness from which radiance blends to irradiance"},
         {"seed", "0", "integer", "sampled,reference", "", "random seed"},
-        {"spp", "256", ">=1", "reference", "", "samples per pixel"},
+        {"spp", "256", ">=1", "reference", "", "samples per pixel (selects the Monte Carlo integrator)"},
+        {"integrator", "quadrature", "quadrature|monte_carlo", "reference", "",
+         "quadrature truth (default; monte_carlo when spp is set)"},
+        {"truth_tolerance", "0.001", ">0", "reference", "", "quadrature truth: the coarser level's per-pixel tolerance"},
         {"threads", "0", ">=0", "reference", "", "CPU threads (0: all)"},
     };
     return table;

@@ -210,6 +210,10 @@ void temporal_html(std::string& o, const json& tp, ImageStore& store) {
     std::vector<std::string> parts;
     for (const char* k : {"flicker", "variation_ratio", "flip_mean"})
         if (auto v = num(tp, k)) parts.push_back(fmt::format("{} <b>{}</b>", k, fmt_num(*v)));
+    // Against the temporal truth (the quadrature truth of every frame), when the golden store has it.
+    const json& truth = sub(tp, "truth");
+    for (const char* k : {"flicker", "flip_mean"})
+        if (auto v = num(truth, k)) parts.push_back(fmt::format("truth {} <b>{}</b>", k, fmt_num(*v)));
     std::string joined;
     for (auto& p : parts) joined += (joined.empty() ? "" : " &middot; ") + p;
     fmt::format_to(out, "<div class=\"meta\">{} &middot; {} frames{}</div>", joined, a.is_array() ? a.size() : 0,

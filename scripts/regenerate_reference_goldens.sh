@@ -1,45 +1,83 @@
 #!/usr/bin/env bash
-# Regenerates the CPU reference goldens under goldens/reference/ (<scene>__<env>.exr + .json).
-# One command:  scripts/regenerate_reference_goldens.sh   (env: SPP=..., JOBS=..., BUILD_DIR=...)
-# Each golden is rendered twice (lighting seeds 0 and 1, the same sub-pixel pattern) to record its noise
-# floor (relative RMSE and mean FLIP between the seeds, renderers/reference/reference.h); the seed-0 image
-# is the golden, and its JSON states whether issue 5's criterion (mean FLIP < 0.002, relative RMSE
-# < 0.5 %) is met (noise_floor.criterion).
-# Per-golden spp: measured in renderers/reference/CONVERGENCE.md (SPP=... overrides them all).
+# Regenerates the reference goldens under goldens/reference/ (<scene>__<env>.exr + .json).
+# One command:  scripts/regenerate_reference_goldens.sh   (env: BUILD_DIR=..., TEMPORAL=1 adds the temporal truth)
+#
+# The truth is the deterministic quadrature (renderers/reference/truth_renderer.h; method and measurements in
+# renderers/reference/CONVERGENCE.md): each golden is the finer of two refinement levels, and its sidecar states
+# the error bound — the two levels' difference as relative RMSE and mean FLIP, per sphere and at the worst
+# pixel — and whether issue 5's criterion (mean FLIP < 0.002, relative RMSE < 0.5 %) is met
+# (error_bound.criterion). Deterministic: the same pixels on every run and thread count.
+# The near-mirror sphere (roughness 0.02, the stability suite's) stays Monte Carlo (the quadrature refuses
+# lobes with α < 2e-3 on smooth spheres): 8192 spp, its noise floor between lighting seeds in the sidecar.
+# TEMPORAL=1 also writes the temporal suite's truth (bumpy_sphere, 32 frames under sky_sun and studio).
+#
+# Expected time (EXPECTED_TIME below, measured on this project's 2-core machine, see CONVERGENCE.md).
 set -euo pipefail
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 BUILD_DIR=${BUILD_DIR:-$ROOT/build}
-JOBS=${JOBS:-2}
-SPP=${SPP:-}
+TEMPORAL=${TEMPORAL:-0}
 OUT=$ROOT/goldens/reference
+EXPECTED_TIME="~40 min wall at load 4-10 / 1755 s CPU (~15 min on an idle 2-core machine), measured 2026-11-23"
 if [[ ! -f "$BUILD_DIR/CMakeCache.txt" ]]; then
   cmake -S "$ROOT" -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
 fi
-cmake --build "$BUILD_DIR" -j"$JOBS" --target iblcheck_reference_tool >/dev/null
+cmake --build "$BUILD_DIR" -j2 --target iblcheck_reference_tool >/dev/null
 TOOL=$(find "$BUILD_DIR" -name iblcheck_reference_tool -type f -perm -u+x | head -1)
 mkdir -p "$OUT"
+# The committed goldens, kept aside to state how far each new one is from it (mean FLIP, relative RMSE).
+OLD=$(mktemp -d)
+trap 'rm -rf "$OLD"' EXIT
+cp "$OUT"/*.exr "$OLD"/ 2>/dev/null || true
+compare_old() { [[ -f "$OLD/$1.exr" ]] && echo --compare && echo "$OLD/$1.exr"; return 0; }
+echo "[goldens] expected: $EXPECTED_TIME"
 start=$(date +%s)
-render() { # scene env spp [key=value...]: the file name is harness/golden_store.h's reference_key
-  # (':' '/' -> '-'; material options appended as __k=v,k=v in sorted order)
-  local scene=$1 env=$2 spp=${SPP:-$3} name sets=() opts=""
-  shift 3
-  for kv in $(printf '%s\n' "$@" | sort); do sets+=(--set "$kv"); opts+="${opts:+,}$kv"; done
-  name="${scene}__${env//[:\/]/-}${opts:+__$opts}"
-  "$TOOL" --scene "$scene" --env "$env" --spp "$spp" --seed 0 --noise-floor "${sets[@]}" \
-    --out "$OUT/$name.exr" --meta "$OUT/$name.json" \
-    --command "scripts/regenerate_reference_goldens.sh (spp=$spp)"
+name_of() { # scene env [key=value...]: harness/golden_store.h's reference_key (':' '/' -> '-'; material
+  # options appended as __k=v,k=v in sorted order)
+  local scene=$1 env=$2 opts=""
+  shift 2
+  for kv in $(printf '%s\n' "$@" | sort); do opts+="${opts:+,}$kv"; done
+  echo "${scene}__${env//[:\/]/-}${opts:+__$opts}"
 }
-# spp per golden and what it reaches (CONVERGENCE.md; the JSON states it in noise_floor.criterion).
-# Issue 5's criterion (FLIP < 0.002, rel. RMSE < 0.5 %) with the windowed estimator: see the comment on
-# each line; all nine meet it. The two Blender sweeps need the most samples (FLIP ∝ N^-0.4 there, CONVERGENCE.md).
-# Whole script: ~100 min on a 2-core machine (the sum of the lines' times; the Blender sweeps ~78 min).
-render furnace constant:1 4096               # ~0.5 min: 0.05 %, FLIP 0.0004
-render furnace_dielectric constant:1 4096    # ~0.5 min: 0.09 %, FLIP 0.0006
-render sphere studio 8192                    # ~1 min: 0.11 %, FLIP 0.0011
-render grazing studio 8192                   # ~1.5 min: 0.06 %, FLIP 0.0005
-render sphere studio 8192 metallic=1 roughness=0.02   # ~1 min: 0.04 %, FLIP 0.0006 (stability suite)
-render roughness_sweep studio 16384          # ~9 min: 0.18 %, FLIP 0.0017
-render roughness_sweep sky_sun 12288         # ~7.5 min: 0.13 %, FLIP 0.0013
-render roughness_sweep blender:sunrise 40960  # ~23 min: 0.08 %, FLIP 0.00194 (FLIP sets the count: CONVERGENCE.md)
-render roughness_sweep blender:interior 98304 # ~55 min: 0.13 %, FLIP 0.00166 (FLIP sets the count: CONVERGENCE.md)
-echo "[goldens] done in $(( $(date +%s) - start )) s -> $OUT"
+sets_of() { for kv in $(printf '%s\n' "$@" | sort); do printf -- '--set\n%s\n' "$kv"; done; }
+truth() { # scene env [key=value...]: the quadrature truth
+  local scene=$1 env=$2 name t0
+  shift 2
+  name=$(name_of "$scene" "$env" "$@")
+  t0=$(date +%s)
+  mapfile -t sets < <(sets_of "$@")
+  mapfile -t cmp < <(compare_old "$name")
+  "$TOOL" --truth --scene "$scene" --env "$env" "${sets[@]}" --out "$OUT/$name.exr" "${cmp[@]}" \
+    --command "scripts/regenerate_reference_goldens.sh"
+  echo "[goldens] $name: $(( $(date +%s) - t0 )) s"
+}
+monte_carlo() { # scene env spp [key=value...]: the Monte Carlo integrator (seeds 0 and 1 for the noise floor)
+  local scene=$1 env=$2 spp=$3 name t0
+  shift 3
+  name=$(name_of "$scene" "$env" "$@")
+  t0=$(date +%s)
+  mapfile -t sets < <(sets_of "$@")
+  "$TOOL" --scene "$scene" --env "$env" --spp "$spp" --seed 0 --noise-floor "${sets[@]}" \
+    --out "$OUT/$name.exr" --meta "$OUT/$name.json" --command "scripts/regenerate_reference_goldens.sh (spp=$spp)"
+  if [[ -f "$OLD/$name.exr" ]]; then "$TOOL" --diff "$OUT/$name.exr" "$OLD/$name.exr" | head -1; fi
+  echo "[goldens] $name: $(( $(date +%s) - t0 )) s"
+}
+truth furnace constant:1
+truth furnace_dielectric constant:1
+truth sphere studio
+truth grazing studio
+monte_carlo sphere studio 8192 metallic=1 roughness=0.02
+truth roughness_sweep studio
+truth roughness_sweep sky_sun
+truth roughness_sweep blender:sunrise
+truth roughness_sweep blender:interior
+if [[ "$TEMPORAL" == 1 ]]; then
+  for env in sky_sun studio; do
+    t0=$(date +%s)
+    "$TOOL" --truth --frames 32 --scene bumpy_sphere --env "$env" --out "$OUT/bumpy_sphere__${env}__frames=32.exr" \
+      --command "TEMPORAL=1 scripts/regenerate_reference_goldens.sh"
+    echo "[goldens] bumpy_sphere__${env}__frames=32: $(( $(date +%s) - t0 )) s"
+  done
+fi
+# Wall time, and the CPU time of every render (user + sys of the finished children: the machine may be shared).
+echo "[goldens] done in $(( $(date +%s) - start )) s wall -> $OUT"
+times | tail -1 | awk '{ print "[goldens] CPU of the renders (user, sys): " $1 ", " $2 }'

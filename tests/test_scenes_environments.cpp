@@ -329,3 +329,20 @@ TEST(Scene, FurnaceLayout) {
     }
     EXPECT_FLOAT_EQ(build_scene("furnace_dielectric", {}).spheres[2].material.metallic, 0.0f);
 }
+
+// The environment hash is FNV-1a-64 (environment.h): the published test vectors (draft-eastlake-fnv,
+// "a" and "foobar"; the empty input is the offset basis itself). Fails with the old basis
+// 1469598103934665603, which had lost a digit.
+TEST(Environment, ContentHashIsFnv1a64) {
+    auto bytes = [](const std::string& s) {
+        cv::Mat m(1, int(s.size()), CV_8UC1);
+        for (size_t i = 0; i < s.size(); ++i) m.at<unsigned char>(0, int(i)) = (unsigned char)s[i];
+        return m;
+    };
+    EXPECT_EQ(fnv1a64_hex(cv::Mat()), "cbf29ce484222325");
+    EXPECT_EQ(fnv1a64_hex(bytes("a")), "af63dc4c8601ec8c");
+    EXPECT_EQ(fnv1a64_hex(bytes("foobar")), "85944171f73967e8");
+    // Rows are hashed in order without padding: a 2x3 view equals its 6 bytes in a row.
+    const cv::Mat two = bytes("foobar").reshape(1, 2);
+    EXPECT_EQ(fnv1a64_hex(two), "85944171f73967e8");
+}

@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
     iblcheck::register_compare_command(app, exit_code);
     iblcheck::cli::register_run_commands(app, exit_code);
     iblcheck::cli::register_report_command(app, exit_code);
+    iblcheck::cli::register_truth_command(app, exit_code);
     {
         std::string line = "iblcheck";
         for (int i = 1; i < argc; ++i) line += std::string(" ") + argv[i];

@@ -35,21 +35,6 @@ std::string valid_specs() {
     return out + ", or a path to an .exr/.hdr file";
 }
 
-std::string fnv1a64_hex(const cv::Mat& m) {
-    uint64_t h = 1469598103934665603ull;
-    for (int r = 0; r < m.rows; ++r) {
-        const auto* p = m.ptr<unsigned char>(r);
-        size_t n = size_t(m.cols) * m.elemSize();
-        for (size_t i = 0; i < n; ++i) {
-            h ^= p[i];
-            h *= 1099511628211ull;
-        }
-    }
-    char buf[17];
-    std::snprintf(buf, sizeof buf, "%016llx", (unsigned long long)h);
-    return buf;
-}
-
 void finish(Environment& env) {
     if (env.equirect.cols != 2 * env.equirect.rows)
         throw InputError("environment '" + env.spec + "'" +
@@ -120,6 +105,23 @@ std::string find_blender(const std::string& name) {
                      "); run scripts/setup.sh to extract Blender's HDRIs");
 }
 } // namespace
+
+// FNV-1a, 64 bits (Fowler, Noll, Vo; draft-eastlake-fnv: offset basis 14695981039346656037, prime
+// 1099511628211). The basis had lost a digit before issue 16's regeneration (every hash changed then).
+std::string fnv1a64_hex(const cv::Mat& m) {
+    uint64_t h = 14695981039346656037ull;
+    for (int r = 0; r < m.rows; ++r) {
+        const auto* p = m.ptr<unsigned char>(r);
+        size_t n = size_t(m.cols) * m.elemSize();
+        for (size_t i = 0; i < n; ++i) {
+            h ^= p[i];
+            h *= 1099511628211ull;
+        }
+    }
+    char buf[17];
+    std::snprintf(buf, sizeof buf, "%016llx", (unsigned long long)h);
+    return buf;
+}
 
 std::vector<EnvironmentInfo> environment_catalog() {
     std::vector<EnvironmentInfo> out = {

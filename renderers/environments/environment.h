@@ -41,6 +41,9 @@ std::vector<EnvironmentInfo> environment_catalog();
 // Throws UsageError for an unknown spec (listing valid ones), InputError for a bad file.
 Environment load_environment(const std::string& spec);
 
+// Hex FNV-1a-64 of an image's bytes, row by row (Environment::content_hash).
+std::string fnv1a64_hex(const cv::Mat& m);
+
 // Direction ↔ equirect helpers (the convention above).
 void direction_to_uv(const float d[3], float& u, float& v);
 void uv_to_direction(float u, float v, float d[3]);

@@ -322,6 +322,22 @@ Hit intersect(const Scene& scene, Vec3f origin, Vec3f dir) {
     return best;
 }
 
+void bump_normal(const Sphere& s, const double p[3], const double n[3], double out[3]) {
+    const double amp = s.bump_amplitude, f = s.bump_frequency, ph = s.bump_phase;
+    if (amp <= 0) {
+        out[0] = n[0], out[1] = n[1], out[2] = n[2];
+        return;
+    }
+    const double sx = std::sin(f * p[0] + ph), cx = std::cos(f * p[0] + ph);
+    const double sy = std::sin(f * p[1] + 0.7 * ph), cy = std::cos(f * p[1] + 0.7 * ph);
+    const double g[3] = {amp * f * cx * sy, amp * f * sx * cy, 0.0};
+    const double gn = g[0] * n[0] + g[1] * n[1] + g[2] * n[2];
+    double m[3], l = 0;
+    for (int i = 0; i < 3; ++i) m[i] = n[i] - (g[i] - gn * n[i]), l += m[i] * m[i];
+    l = 1 / std::sqrt(l);
+    for (int i = 0; i < 3; ++i) out[i] = m[i] * l;
+}
+
 void camera_ray(const Scene& scene, int width, int height, double px, double py, Vec3f& origin, Vec3f& dir) {
     const Camera& c = scene.camera;
     auto normalize = [](double x, double y, double z, double out[3]) {

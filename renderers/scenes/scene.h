@@ -85,6 +85,13 @@ Hit intersect(const Scene& scene, Vec3f origin, Vec3f dir);
 // reference integrator's culled loop, so both see the same arithmetic.
 double intersect_sphere(const Sphere& s, Vec3f origin, Vec3f dir, double oc[3]);
 
+// Animated normal detail (bumpy_sphere): the height field h = A sin(f x + φ) sin(f y + 0.7 φ) of the
+// point p on the sphere relative to its centre (world units), with its exact gradient; the normal n
+// tilts by the gradient's tangential part, n' = normalize(n − (∇h − (∇h·n) n)) (Blinn 1978). The
+// shaders' scene.glsl evaluates the same field; this is the CPU definition the reference integrates.
+// Returns n unchanged when the sphere has no bumps.
+void bump_normal(const Sphere& s, const double p[3], const double n[3], double out[3]);
+
 // Camera ray through (px, py) in pixel units (x + sx, y + sy); see the convention above.
 void camera_ray(const Scene& scene, int width, int height, double px, double py, Vec3f& origin, Vec3f& dir);
 
