@@ -33,13 +33,16 @@ json approved_accuracy(const GoldenStore& store, const TestSpec& spec, const cv:
     auto ref = store.reference(spec);
     if (!ref || ref->image.size() != image.size()) return json::object();
     json m = compare_images(ref->image, image, 0);
-    return {{"flip.mean", m["flip"]["mean"]}, {"flip.p99", m["flip"]["p99"]}, {"flip.block_max", m["flip"]["block_max"]},
-            {"ssim.mean", m["ssim"]["mean"]}, {"psnr.db", m["psnr"]["db"]}};
+    return {{"flip.mean", m["flip"]["mean"]},
+            {"flip.p99", m["flip"]["p99"]},
+            {"flip.block_max", m["flip"]["block_max"]},
+            {"ssim.mean", m["ssim"]["mean"]},
+            {"psnr.db", m["psnr"]["db"]}};
 }
 
 // What changed against the baseline already there: "new", "unchanged", or how it changed.
 struct Change {
-    bool pixels = true, judged = true;  // pixels differ; a judged figure of the sidecar differs
+    bool pixels = true, judged = true; // pixels differ; a judged figure of the sidecar differs
     std::string text = "new";
 };
 
@@ -51,9 +54,12 @@ Change change_against(const fs::path& path, const cv::Mat& image, const json& pr
     c.pixels = !bit_identical(old, image);
     c.judged = !oldp.is_object() || oldp.value("accuracy", json()) != prov["accuracy"] ||
                oldp.value("cost", json()) != prov["cost"] || oldp.value("size", json()) != prov["size"];
-    if (!c.pixels) c.text = c.judged ? "pixels unchanged; sidecar's accuracy/cost updated" : "unchanged";
-    else if (old.size() != image.size()) c.text = fmt::format("changed size {}x{} -> {}x{}", old.cols, old.rows, image.cols, image.rows);
-    else c.text = fmt::format("changed: FLIP vs old baseline {:.5f}", compare_images(old, image, 0)["flip"]["mean"].get<double>());
+    if (!c.pixels)
+        c.text = c.judged ? "pixels unchanged; sidecar's accuracy/cost updated" : "unchanged";
+    else if (old.size() != image.size())
+        c.text = fmt::format("changed size {}x{} -> {}x{}", old.cols, old.rows, image.cols, image.rows);
+    else
+        c.text = fmt::format("changed: FLIP vs old baseline {:.5f}", compare_images(old, image, 0)["flip"]["mean"].get<double>());
     if (oldp.is_object() && oldp.contains("accuracy") && oldp["accuracy"].contains("flip.mean") &&
         prov["accuracy"].contains("flip.mean") && oldp["accuracy"] != prov["accuracy"])
         c.text += fmt::format("; accuracy FLIP {:.5f} -> {:.5f}", oldp["accuracy"]["flip.mean"].get<double>(),
@@ -116,8 +122,10 @@ int bless(const BlessOptions& o) {
             continue;
         }
         try {
-            if (change.pixels) GoldenStore::write_golden(path, rr.image, prov);
-            else GoldenStore::write_sidecar(path, prov);
+            if (change.pixels)
+                GoldenStore::write_golden(path, rr.image, prov);
+            else
+                GoldenStore::write_sidecar(path, prov);
         } catch (const std::exception& e) {
             fmt::print(stderr, "error: {}: not blessed: {}\n", tc.name, e.what());
             ++failed;

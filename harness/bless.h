@@ -15,7 +15,7 @@ namespace iblcheck {
 struct BlessOptions {
     std::string suite = "ci";
     std::string filter;
-    std::optional<std::string> label;   // absent: the primary baseline; else baseline@LABEL
+    std::optional<std::string> label; // absent: the primary baseline; else baseline@LABEL
     std::filesystem::path goldens;
     std::string device;
     bool dry_run = false;

@@ -60,15 +60,23 @@ std::vector<char*> c_strings(std::vector<std::string>& v) {
 }
 } // namespace
 
-ChildRender render_in_child(const TestSpec& spec, const std::map<std::string, std::string>& env,
-                            const std::string& device) {
+ChildRender render_in_child(const TestSpec& spec, const std::map<std::string, std::string>& env, const std::string& device) {
     char dir_template[] = "/tmp/iblcheck-child-XXXXXX";
     if (!mkdtemp(dir_template)) throw EnvironmentError(std::string("/tmp: cannot create a folder: ") + std::strerror(errno));
     const fs::path dir = dir_template;
     const fs::path exr = dir / "render.exr", json_file = dir / "render.json", log = dir / "log.txt";
 
-    std::vector<std::string> args = {iblcheck_executable().string(), "render", "--scene", spec.scene, "--method",
-                                     spec.method, "--env", spec.env, "--out", exr.string(), "--json",
+    std::vector<std::string> args = {iblcheck_executable().string(),
+                                     "render",
+                                     "--scene",
+                                     spec.scene,
+                                     "--method",
+                                     spec.method,
+                                     "--env",
+                                     spec.env,
+                                     "--out",
+                                     exr.string(),
+                                     "--json",
                                      json_file.string()};
     if (spec.width > 0) args.insert(args.end(), {"--size", fmt::format("{}x{}", spec.width, spec.height)});
     if (!device.empty()) args.insert(args.end(), {"--device", device});
@@ -88,15 +96,14 @@ ChildRender render_in_child(const TestSpec& spec, const std::map<std::string, st
         throw EnvironmentError(fmt::format("{}: cannot start a child render: {}", args[0], std::strerror(rc)));
     }
     int status = 0;
-    while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-    }
+    while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {}
     std::string env_text;
     for (const auto& [k, v] : env) env_text += k + "=" + v + " ";
     if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
         std::string out = tail_of(log);
         fs::remove_all(dir);
-        throw Error(fmt::format("child render ({}{} {} {}) failed with {} {}: {}", env_text, spec.method, spec.scene,
-                                spec.env, WIFEXITED(status) ? "exit code" : "signal",
+        throw Error(fmt::format("child render ({}{} {} {}) failed with {} {}: {}", env_text, spec.method, spec.scene, spec.env,
+                                WIFEXITED(status) ? "exit code" : "signal",
                                 WIFEXITED(status) ? WEXITSTATUS(status) : WTERMSIG(status), out));
     }
     ChildRender r;

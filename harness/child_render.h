@@ -17,8 +17,8 @@
 namespace iblcheck {
 
 struct ChildRender {
-    cv::Mat image;              // CV_32FC3 linear, as the child wrote it (float EXR: exact)
-    nlohmann::json provenance;  // the child's render provenance (`iblcheck render --json`)
+    cv::Mat image;             // CV_32FC3 linear, as the child wrote it (float EXR: exact)
+    nlohmann::json provenance; // the child's render provenance (`iblcheck render --json`)
 };
 
 // The iblcheck executable: this process if it is iblcheck, else the one built beside the tests.
@@ -27,7 +27,6 @@ std::filesystem::path iblcheck_executable();
 // Renders `spec` with `iblcheck render` in a child whose environment is this one plus `env`.
 // Throws EnvironmentError (no executable) or Error (the child failed: its exit code and the last
 // lines of its output).
-ChildRender render_in_child(const TestSpec& spec, const std::map<std::string, std::string>& env,
-                            const std::string& device = "");
+ChildRender render_in_child(const TestSpec& spec, const std::map<std::string, std::string>& env, const std::string& device = "");
 
 } // namespace iblcheck

@@ -73,8 +73,10 @@ std::string reference_key(const TestSpec& spec) {
 
 GoldenStore::GoldenStore(fs::path root) {
     if (root.empty()) {
-        if (const char* e = std::getenv("IBLCHECK_GOLDEN_DIR"); e && *e) root = e;
-        else root = fs::path(IBLCHECK_SOURCE_DIR) / "goldens";
+        if (const char* e = std::getenv("IBLCHECK_GOLDEN_DIR"); e && *e)
+            root = e;
+        else
+            root = fs::path(IBLCHECK_SOURCE_DIR) / "goldens";
     }
     root_ = root;
 }
@@ -88,9 +90,7 @@ fs::path GoldenStore::baseline_path(const std::string& test_name, const std::str
     return root_ / "baseline" / (safe_file_name(test_name) + (label.empty() ? "" : "@" + label) + ".exr");
 }
 
-fs::path GoldenStore::reference_path(const TestSpec& spec) const {
-    return root_ / "reference" / (reference_key(spec) + ".exr");
-}
+fs::path GoldenStore::reference_path(const TestSpec& spec) const { return root_ / "reference" / (reference_key(spec) + ".exr"); }
 
 std::vector<Golden> GoldenStore::baselines(const std::string& test_name) const {
     std::vector<Golden> out;
@@ -178,8 +178,7 @@ void GoldenStore::write_golden(const fs::path& exr, const cv::Mat& image, const 
 std::string project_commit(bool* dirty) {
     std::string dir = IBLCHECK_SOURCE_DIR;
     std::string c = run_capture("git -C '" + dir + "' rev-parse --short=12 HEAD 2>/dev/null");
-    if (dirty)
-        *dirty = !run_capture("git -C '" + dir + "' status --porcelain --untracked-files=no 2>/dev/null").empty();
+    if (dirty) *dirty = !run_capture("git -C '" + dir + "' status --porcelain --untracked-files=no 2>/dev/null").empty();
     return c.empty() ? "unknown" : c;
 }
 

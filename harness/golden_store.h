@@ -21,9 +21,9 @@ namespace iblcheck {
 
 struct Golden {
     std::filesystem::path image_path;
-    cv::Mat image;               // CV_32FC3 linear
-    nlohmann::json provenance = nlohmann::json::object();  // sidecar
-    std::string label;           // "" for the primary baseline, else the @label
+    cv::Mat image;                                        // CV_32FC3 linear
+    nlohmann::json provenance = nlohmann::json::object(); // sidecar
+    std::string label;                                    // "" for the primary baseline, else the @label
 };
 
 class GoldenStore {

@@ -69,7 +69,7 @@ json per_sphere_errors(const TestSpec& spec, const cv::Mat& errmap) {
 SphereLayout sphere_layout(const TestSpec& spec, int width, int height) {
     Scene scene = build_scene(spec.scene, spec.options);
     SphereLayout out;
-    if (scene.spheres.size() > 254) return out;  // does not fit the 8-bit map: no layout
+    if (scene.spheres.size() > 254) return out; // does not fit the 8-bit map: no layout
     out.ids = cv::Mat(height, width, CV_8U);
     for (int y = 0; y < height; ++y)
         for (int x = 0; x < width; ++x) out.ids.at<uchar>(y, x) = uchar(sphere_index(scene, width, height, x, y) + 1);

@@ -11,8 +11,7 @@ namespace iblcheck {
 
 // HDR-FLIP, SSIM (on the display transform; null with "not_applicable" under 11x11) and PSNR of
 // `test` against `golden` (same size, finite). `flip_out` receives the FLIP result with its map.
-nlohmann::json compare_images(const cv::Mat& golden, const cv::Mat& test, int flip_threads,
-                              FlipResult* flip_out = nullptr);
+nlohmann::json compare_images(const cv::Mat& golden, const cv::Mat& test, int flip_threads, FlipResult* flip_out = nullptr);
 
 // Mean FLIP per sphere of a multi-sphere scene (null for single-sphere scenes), labelled with the
 // scene's sphere names.

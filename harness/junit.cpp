@@ -22,11 +22,12 @@ void write_junit(const json& results, const fs::path& file) {
     }
     std::string suite = results.value("suite", "iblcheck");
     std::string x = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
-    x += fmt::format("<testsuites name=\"iblcheck\" tests=\"{}\" failures=\"{}\" errors=\"{}\" time=\"{:.3f}\">\n",
-                     tests.size(), failures, errors, results.value("total_s", 0.0));
-    x += fmt::format("  <testsuite name=\"{}\" tests=\"{}\" failures=\"{}\" errors=\"{}\" skipped=\"0\" time=\"{:.3f}\" timestamp=\"{}\">\n",
-                     escape_markup(suite), tests.size(), failures, errors, results.value("total_s", 0.0),
-                     escape_markup(results.value("started", "")));
+    x += fmt::format("<testsuites name=\"iblcheck\" tests=\"{}\" failures=\"{}\" errors=\"{}\" time=\"{:.3f}\">\n", tests.size(),
+                     failures, errors, results.value("total_s", 0.0));
+    x += fmt::format(
+        "  <testsuite name=\"{}\" tests=\"{}\" failures=\"{}\" errors=\"{}\" skipped=\"0\" time=\"{:.3f}\" timestamp=\"{}\">\n",
+        escape_markup(suite), tests.size(), failures, errors, results.value("total_s", 0.0),
+        escape_markup(results.value("started", "")));
     for (auto& t : tests) {
         std::string name = t.value("name", "?"), v = t.value("verdict", "error"), msg = t.value("message", "");
         x += fmt::format("    <testcase classname=\"{}.{}\" name=\"{}\" time=\"{:.3f}\">", escape_markup(suite),
@@ -35,7 +36,8 @@ void write_junit(const json& results, const fs::path& file) {
             x += fmt::format("\n      <failure type=\"{}\" message=\"{}\">{}\nrebless: {}</failure>\n    ", v, escape_markup(msg),
                              escape_markup(msg), escape_markup(t.value("bless_command", "")));
         else if (v == "error")
-            x += fmt::format("\n      <error type=\"error\" message=\"{}\">{}</error>\n    ", escape_markup(msg), escape_markup(msg));
+            x += fmt::format("\n      <error type=\"error\" message=\"{}\">{}</error>\n    ", escape_markup(msg),
+                             escape_markup(msg));
         else if (v == "improved")
             x += fmt::format("\n      <system-out>improved: {}</system-out>\n    ", escape_markup(msg));
         x += "</testcase>\n";

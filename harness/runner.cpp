@@ -41,7 +41,7 @@ namespace {
 // scale and exceedance mask work on.
 struct Artefacts {
     fs::path dir;
-    std::string rel;  // "images/<test>/"
+    std::string rel; // "images/<test>/"
     explicit operator bool() const { return !dir.empty(); }
     static std::string exr(const std::string& png) { return png.substr(0, png.rfind('.')) + ".exr"; }
     std::string png(const std::string& name, const cv::Mat& linear, bool with_exr = true) const {
@@ -55,10 +55,10 @@ struct Artefacts {
     std::string shared_exr(const std::string& golden_rel, const cv::Mat& linear) const {
         const fs::path shared = dir.parent_path() / "_goldens";
         const std::string file = safe_file_name(golden_rel);
-        if (!fs::exists(shared / file)) {  // two workers (or processes) may both write it: same pixels, atomic rename
+        if (!fs::exists(shared / file)) { // two workers (or processes) may both write it: same pixels, atomic rename
             fs::create_directories(shared);
             const fs::path tmp = shared / (file + fmt::format(".tmp{}-{}.exr", ::getpid(),
-                                                               std::hash<std::thread::id>{}(std::this_thread::get_id())));
+                                                              std::hash<std::thread::id>{}(std::this_thread::get_id())));
             write_exr_half(tmp.string(), linear);
             fs::rename(tmp, shared / file);
         }
@@ -72,7 +72,7 @@ struct Artefacts {
     }
     // A comparison's images: {test, golden, heatmap} PNGs and their EXRs (test_exr, golden_exr, error_exr).
     static json images(const std::string& test, const std::string& golden, const std::string& heatmap) {
-        return {{"test", test}, {"golden", golden}, {"heatmap", heatmap},
+        return {{"test", test},          {"golden", golden},          {"heatmap", heatmap},
                 {"test_exr", exr(test)}, {"golden_exr", exr(golden)}, {"error_exr", exr(heatmap)}};
     }
     // Which sphere is where (the report names the sphere under the pointer): an 8-bit id map.
@@ -89,9 +89,17 @@ struct Artefacts {
 
 // What the test is, before anything is rendered.
 json test_header(const TestCase& tc) {
-    return {{"name", tc.name}, {"suite", tc.suite}, {"scene", tc.spec.scene}, {"method", tc.spec.method},
-            {"env", tc.spec.env}, {"options", tc.spec.options.values()}, {"variant", tc.variant}, {"tags", tc.tags},
-            {"bless_command", bless_command(tc)}, {"comparisons", json::array()}, {"accuracy", nullptr},
+    return {{"name", tc.name},
+            {"suite", tc.suite},
+            {"scene", tc.spec.scene},
+            {"method", tc.spec.method},
+            {"env", tc.spec.env},
+            {"options", tc.spec.options.values()},
+            {"variant", tc.variant},
+            {"tags", tc.tags},
+            {"bless_command", bless_command(tc)},
+            {"comparisons", json::array()},
+            {"accuracy", nullptr},
             {"driver_mismatch", nullptr}};
 }
 
@@ -108,7 +116,7 @@ void record_render(json& r, const RenderResult& rr) {
     r["precompute_ms"] = pre;
     r["frame_ms"] = frame;
     r["texture_fetches_per_pixel"] = rr.texture_fetches_per_pixel;
-    if (rr.texture_bytes > 0) {  // the bytes/accuracy chart's x (mobile: the prefiltered chain)
+    if (rr.texture_bytes > 0) { // the bytes/accuracy chart's x (mobile: the prefiltered chain)
         r["texture_bytes"] = rr.texture_bytes;
         r["texel_count"] = rr.texel_count;
     }
@@ -135,8 +143,8 @@ void repeat_timings(json& r, const TestCase& tc, Worker& w, int repeats) {
 // Where the error concentrates, for a person: "worst 16x16 block at (160,16) on metal r=0.3 ...".
 // Recorded on the comparison ({x, y, flip, sphere}); a failing comparison's message says it too.
 void note_worst_block(Comparison& c, const TestSpec& spec, const FlipResult& flip, int width, int height) {
-    std::string sphere = sphere_at(spec, width, height, std::min(flip.block_x + 8, width - 1),
-                                   std::min(flip.block_y + 8, height - 1));
+    std::string sphere =
+        sphere_at(spec, width, height, std::min(flip.block_x + 8, width - 1), std::min(flip.block_y + 8, height - 1));
     c.worst_block = {{"x", flip.block_x}, {"y", flip.block_y}, {"flip", flip.block_max}, {"sphere", sphere}};
     if (c.verdict == Verdict::fail)
         c.message += fmt::format("; worst 16x16 block at ({},{}){} with mean FLIP {:.4g}", flip.block_x, flip.block_y,
@@ -146,21 +154,21 @@ void note_worst_block(Comparison& c, const TestSpec& spec, const FlipResult& fli
 struct BaselineOutcome {
     Comparison comparison;
     bool missing = false;
-    Golden golden;       // the baseline judged against (empty image when missing)
+    Golden golden; // the baseline judged against (empty image when missing)
 };
 
 // Any of the test's approved baselines may pass it; the report shows the one that did, or the
 // closest one.
-BaselineOutcome judge_against_baselines(const TestCase& tc, const cv::Mat& image, const GoldenStore& store,
-                                        const Artefacts& art, int flip_threads) {
+BaselineOutcome judge_against_baselines(const TestCase& tc, const cv::Mat& image, const GoldenStore& store, const Artefacts& art,
+                                        int flip_threads) {
     BaselineOutcome out;
     std::vector<Golden> goldens = store.baselines(tc.name);
     if (goldens.empty()) {
         out.missing = true;
         out.comparison.kind = "baseline";
         out.comparison.verdict = Verdict::missing_golden;
-        out.comparison.message = "no baseline golden at " + store.baseline_path(tc.name).string() +
-                                 "; create it with: " + bless_command(tc);
+        out.comparison.message =
+            "no baseline golden at " + store.baseline_path(tc.name).string() + "; create it with: " + bless_command(tc);
         return out;
     }
     std::vector<Comparison> candidates;
@@ -199,7 +207,12 @@ std::vector<Check> judge_costs(const TestCase& tc, const RenderResult& rr, const
     const json now = render_cost(rr), approved = golden.provenance.value("cost", json::object());
     for (auto& [key, value] : now.items()) {
         if (!approved.contains(key) || !approved[key].is_number()) {
-            Check c{"cost." + key, value.get<double>(), {}, {}, {}, Verdict::fail,
+            Check c{"cost." + key,
+                    value.get<double>(),
+                    {},
+                    {},
+                    {},
+                    Verdict::fail,
                     "cost." + key + ": the baseline records no approved cost; re-bless it (" + bless_command(tc) + ")"};
             out.push_back(c);
             continue;
@@ -222,7 +235,9 @@ Comparison judge_against_truth(const TestCase& tc, const cv::Mat& image, const G
     Comparison c = judge_reference(metrics, approved_accuracy, tc.reference_band);
     c.golden = store.relative(ref.image_path);
     note_worst_block(c, tc.spec, flip, image.cols, image.rows);
-    r["accuracy"] = {{"flip_mean", flip.mean}, {"ssim", metrics["ssim"]["mean"]}, {"golden", c.golden},
+    r["accuracy"] = {{"flip_mean", flip.mean},
+                     {"ssim", metrics["ssim"]["mean"]},
+                     {"golden", c.golden},
                      {"noise_floor", ref.provenance.value("noise_floor", json())}};
     if (json ps = per_sphere_errors(tc.spec, flip.errmap); !ps.is_null()) r["per_sphere"] = ps;
     if (art) {
@@ -277,7 +292,9 @@ json run_test(const TestCase& tc, Worker& w, const GoldenStore& store, const fs:
             base = judge_against_baselines(tc, rr.image, store, art, flip_threads);
             r["comparisons"].push_back(to_json(base.comparison));
             if (!base.missing) r["comparisons"].back()["approved"] = baseline_facts(base.golden.provenance);
-            add(base.comparison.verdict, base.missing ? base.comparison.message : base.comparison.message.empty() ? "" : "baseline: " + base.comparison.message);
+            add(base.comparison.verdict, base.missing                      ? base.comparison.message
+                                         : base.comparison.message.empty() ? ""
+                                                                           : "baseline: " + base.comparison.message);
             if (!base.missing) {
                 const Comparison cost = cost_comparison(tc, rr, base);
                 r["comparisons"].push_back(to_json(cost));
@@ -301,8 +318,8 @@ json run_test(const TestCase& tc, Worker& w, const GoldenStore& store, const fs:
             for (const Check& k : t.checks) add(k.status, k.message.empty() ? "" : "temporal: " + k.message);
         }
         if (tc.stability.enabled) {
-            StabilityOutcome s = run_stability(tc, w, rr.image, reference,
-                                               base.golden.provenance.value("accuracy", json()), flip_threads);
+            StabilityOutcome s =
+                run_stability(tc, w, rr.image, reference, base.golden.provenance.value("accuracy", json()), flip_threads);
             r["stability"] = s.json;
             bool fails = !s.deterministic || (s.flaky && tc.stability.fail_on_flaky);
             add(fails ? Verdict::fail : Verdict::pass, s.problem);
@@ -347,11 +364,11 @@ class OutDirLock {
             ssize_t n = ::pread(fd_, buf, sizeof buf - 1, 0);
             ::close(fd_);
             throw UsageError(fmt::format("{}: another iblcheck run{} is writing into this folder; wait for it or use "
-                                         "another --out", dir.string(), n > 0 ? fmt::format(" (pid {})", buf) : ""));
+                                         "another --out",
+                                         dir.string(), n > 0 ? fmt::format(" (pid {})", buf) : ""));
         }
         std::string pid = std::to_string(::getpid());
-        if (::ftruncate(fd_, 0) == 0 && ::pwrite(fd_, pid.data(), pid.size(), 0) < 0) {
-        }
+        if (::ftruncate(fd_, 0) == 0 && ::pwrite(fd_, pid.data(), pid.size(), 0) < 0) {}
     }
     ~OutDirLock() {
         if (fd_ >= 0) ::close(fd_);
@@ -377,8 +394,8 @@ void write_json_atomically(const fs::path& file, const json& j) {
 void print_test_line(const json& r, int n, size_t total, bool interactive) {
     std::string acc = r["accuracy"].is_object() ? fmt::format("  vs truth {:.4f}", r["accuracy"]["flip_mean"].get<double>()) : "";
     const std::string v = r["verdict"].get<std::string>();
-    fmt::print("{}[{:>3}/{}] {:<15} {}{}  ({:.1f} s)\n", interactive ? "\r" : "", n, total, v,
-               r["name"].get<std::string>(), acc, r["wall_s"].get<double>());
+    fmt::print("{}[{:>3}/{}] {:<15} {}{}  ({:.1f} s)\n", interactive ? "\r" : "", n, total, v, r["name"].get<std::string>(), acc,
+               r["wall_s"].get<double>());
     for (const std::string& line : verdict_details(r)) fmt::print("          {}\n", line);
     std::fflush(stdout);
 }
@@ -394,8 +411,8 @@ void print_run_summary(const json& R, const RunSummary& s, size_t n_tests, const
     for (const std::string& f : fp16)
         fmt::print("precision=mediump ran with {} fp16{}\n", f,
                    f == "emulated" ? " (no shaderFloat16: fp32 rounded to fp16 after every fp16 operation)" : " (float16_t)");
-    fmt::print("{} tests: {} pass, {} fail, {} improved, {} missing-golden, {} error  ({:.1f} s){}\n", n_tests,
-               s.pass, s.fail, s.improved, s.missing, s.error, R["total_s"].get<double>(),
+    fmt::print("{} tests: {} pass, {} fail, {} improved, {} missing-golden, {} error  ({:.1f} s){}\n", n_tests, s.pass, s.fail,
+               s.improved, s.missing, s.error, R["total_s"].get<double>(),
                o.out_dir.empty() ? "" : "  report: " + (o.out_dir / "index.html").string());
     if (std::string all = rebless_all_line(R["tests"], suite_arg); !all.empty()) fmt::print("{}\n", all);
 }
@@ -469,7 +486,8 @@ RunSummary run_suite(const RunOptions& o) {
         s.error += v == Verdict::error;
         R["tests"].push_back(r);
     }
-    R["counts"] = {{"pass", s.pass}, {"fail", s.fail}, {"improved", s.improved}, {"missing-golden", s.missing}, {"error", s.error}};
+    R["counts"] = {
+        {"pass", s.pass}, {"fail", s.fail}, {"improved", s.improved}, {"missing-golden", s.missing}, {"error", s.error}};
     s.shader_compile_error = shader_error;
 
     if (!o.out_dir.empty()) write_json_atomically(o.out_dir / "results.json", R);

@@ -17,25 +17,25 @@ namespace iblcheck {
 
 struct RunOptions {
     std::string suite = "ci";
-    std::string filter;                 // glob on test names
+    std::string filter; // glob on test names
     int shard_index = 0, shard_count = 1;
-    int jobs = 0;                       // 0: the suite's default
-    std::filesystem::path out_dir;      // results.json, images/, index.html; empty: no files
-    std::filesystem::path junit;        // JUnit XML
-    std::filesystem::path json;         // results JSON copy
-    std::filesystem::path history;      // append one line per run
-    std::filesystem::path goldens;      // golden root override
-    std::string device;                 // Vulkan device override
-    std::string command_line;           // for the report
+    int jobs = 0;                  // 0: the suite's default
+    std::filesystem::path out_dir; // results.json, images/, index.html; empty: no files
+    std::filesystem::path junit;   // JUnit XML
+    std::filesystem::path json;    // results JSON copy
+    std::filesystem::path history; // append one line per run
+    std::filesystem::path goldens; // golden root override
+    std::string device;            // Vulkan device override
+    std::string command_line;      // for the report
     bool quiet = false;
-    bool report = true;                 // write index.html when out_dir is set
-    bool stability = false;             // measure determinism, noise floors and margins for every test
+    bool report = true;     // write index.html when out_dir is set
+    bool stability = false; // measure determinism, noise floors and margins for every test
 };
 
 struct RunSummary {
     nlohmann::json results;
     int pass = 0, fail = 0, improved = 0, missing = 0, error = 0;
-    bool shader_compile_error = false;  // some render failed to compile its shaders (bisect: 125)
+    bool shader_compile_error = false; // some render failed to compile its shaders (bisect: 125)
     int exit_code() const;
 };
 

@@ -51,8 +51,10 @@ json margins_of(const TestCase& tc, const std::map<std::string, double>& floor, 
         margins[name] = it->second > 0 ? json(width / it->second) : json();
     };
     for (auto& [metric, bound] : tc.baseline_tolerances) {
-        if (bound.max) margin(metric, *bound.max);
-        else if (bound.min) margin(metric, 1.0 - *bound.min);
+        if (bound.max)
+            margin(metric, *bound.max);
+        else if (bound.min)
+            margin(metric, 1.0 - *bound.min);
     }
     for (auto& [metric, band] : tc.reference_band) {
         if (!approved_accuracy.is_object() || !approved_accuracy.contains(metric)) continue;
@@ -65,13 +67,17 @@ json margins_of(const TestCase& tc, const std::map<std::string, double>& floor, 
 json sensitivity(const TestCase& tc, Worker& w, const cv::Mat& base, int flip_threads) {
     const StabilitySpec& st = tc.stability;
     json sens;
-    for (auto [key, value] : {std::pair<std::string, std::string>{"camera_shift", fmt::format("{},{},0", st.camera_shift, st.camera_shift)},
-                              std::pair<std::string, std::string>{"roughness_bias", fmt::format("{}", st.roughness_bias)}}) {
+    for (auto [key, value] :
+         {std::pair<std::string, std::string>{"camera_shift", fmt::format("{},{},0", st.camera_shift, st.camera_shift)},
+          std::pair<std::string, std::string>{"roughness_bias", fmt::format("{}", st.roughness_bias)}}) {
         TestSpec p = tc.spec;
         p.options.set(key, value);
         json m = compare_images(base, w.renderer.render(p).image, flip_threads);
-        sens[key] = {{"value", value}, {"flip.mean", m["flip"]["mean"]}, {"flip.p99", m["flip"]["p99"]},
-                     {"flip.block_max", m["flip"]["block_max"]}, {"ssim.mean", m["ssim"]["mean"]}};
+        sens[key] = {{"value", value},
+                     {"flip.mean", m["flip"]["mean"]},
+                     {"flip.p99", m["flip"]["p99"]},
+                     {"flip.block_max", m["flip"]["block_max"]},
+                     {"ssim.mean", m["ssim"]["mean"]}};
     }
     return sens;
 }
@@ -112,8 +118,8 @@ StabilityOutcome run_stability(const TestCase& tc, Worker& w, const cv::Mat& bas
             variants.emplace_back("cpu " + caps, c.image);
         }
     std::map<std::string, double> floor, seed_floor, cpu_floor;
-    json m_ref_base = reference.empty() || reference.size() != base.size() ? json()
-                                                                             : compare_images(reference, base, flip_threads);
+    json m_ref_base =
+        reference.empty() || reference.size() != base.size() ? json() : compare_images(reference, base, flip_threads);
     for (const auto& [name, v] : variants) {
         const bool is_cpu = name.rfind("cpu ", 0) == 0;
         auto& kind_floor = is_cpu ? cpu_floor : seed_floor;

@@ -12,10 +12,10 @@
 namespace iblcheck {
 
 struct StabilityOutcome {
-    nlohmann::json json;         // the test's "stability" results object
+    nlohmann::json json; // the test's "stability" results object
     bool deterministic = true;
     bool flaky = false;
-    std::string problem;         // why it is non-deterministic or flaky ("" otherwise)
+    std::string problem; // why it is non-deterministic or flaky ("" otherwise)
 };
 
 // `base`: the render the verdict used; `reference`: the reference golden (may be empty); `approved_accuracy`: the baseline's

@@ -46,7 +46,7 @@ struct Ctx : JsonChecker {
         keys(j, where, kMetrics);
         for (auto& [metric, b] : j.items()) {
             std::string w = where + "." + metric;
-            if (b.is_null()) {  // null drops a suite default: the metric is not checked for this test
+            if (b.is_null()) { // null drops a suite default: the metric is not checked for this test
                 out[metric] = Bound{};
                 continue;
             }
@@ -77,8 +77,8 @@ struct Ctx : JsonChecker {
 };
 
 StabilitySpec parse_stability(const Ctx& c, const json& j, const std::string& where, StabilitySpec st) {
-    c.keys(j, where, {"repeats", "seeds", "thread_counts", "roughness_bias", "camera_shift", "min_margin", "fail_on_flaky",
-                      "cpu_caps"});
+    c.keys(j, where,
+           {"repeats", "seeds", "thread_counts", "roughness_bias", "camera_shift", "min_margin", "fail_on_flaky", "cpu_caps"});
     st.enabled = true;
     if (j.contains("repeats")) st.repeats = int(c.num(j["repeats"], where + ".repeats"));
     if (j.contains("seeds")) st.seeds = int(c.num(j["seeds"], where + ".seeds"));
@@ -95,7 +95,9 @@ StabilitySpec parse_stability(const Ctx& c, const json& j, const std::string& wh
             std::string v = c.str(caps[k], where + ".cpu_caps[" + std::to_string(k) + "]");
             // The values Mesa 22.3 recognises (u_cpu_detect.c); others are silently ignored by Mesa.
             static const std::set<std::string> known = {"nosse", "sse", "sse2", "sse3", "ssse3", "sse4.1", "avx"};
-            if (!known.count(v)) c.fail(where + ".cpu_caps[" + std::to_string(k) + "]", "'" + v + "' is not one of nosse, sse, sse2, sse3, ssse3, sse4.1, avx (Mesa ignores other values)");
+            if (!known.count(v))
+                c.fail(where + ".cpu_caps[" + std::to_string(k) + "]",
+                       "'" + v + "' is not one of nosse, sse, sse2, sse3, ssse3, sse4.1, avx (Mesa ignores other values)");
             st.cpu_caps.push_back(v);
         }
     }
@@ -166,11 +168,12 @@ struct SuiteDefaults {
 
 // "defaults": what every test inherits, plus the suite-wide jobs and timing_repeats.
 SuiteDefaults parse_defaults(const Ctx& c, const json& defaults, Suite& suite) {
-    c.keys(defaults, "defaults", {"env", "size", "jobs", "baseline_tolerances", "reference_band", "stability",
-                                  "max_cost_growth", "timing_repeats"});
+    c.keys(defaults, "defaults",
+           {"env", "size", "jobs", "baseline_tolerances", "reference_band", "stability", "max_cost_growth", "timing_repeats"});
     SuiteDefaults d;
     if (defaults.contains("max_cost_growth")) d.max_cost_growth = c.num(defaults["max_cost_growth"], "defaults.max_cost_growth");
-    if (defaults.contains("stability")) d.stability = parse_stability(c, defaults["stability"], "defaults.stability", d.stability);
+    if (defaults.contains("stability"))
+        d.stability = parse_stability(c, defaults["stability"], "defaults.stability", d.stability);
     if (defaults.contains("env")) d.env = c.str(defaults["env"], "defaults.env");
     if (defaults.contains("size")) parse_size(c, defaults["size"], "defaults.size", d.width, d.height);
     if (defaults.contains("jobs")) suite.jobs = int(c.num(defaults["jobs"], "defaults.jobs"));
@@ -197,8 +200,9 @@ TemporalSpec parse_temporal(const Ctx& c, const json& tj, const std::string& tw)
         temporal.reference_options = c.options(tj["reference_options"], tw + ".reference_options");
     if (tj.contains("checks")) {
         const json& cj = tj["checks"];
-        c.keys(cj, tw + ".checks", {"flicker", "variation_ratio", "flip_mean", "flicker_ratio", "flip_ratio", "truth_flicker",
-                                    "truth_flip_mean", "truth_flip_ratio"});
+        c.keys(cj, tw + ".checks",
+               {"flicker", "variation_ratio", "flip_mean", "flicker_ratio", "flip_ratio", "truth_flicker", "truth_flip_mean",
+                "truth_flip_ratio"});
         for (auto& [k, b] : cj.items()) {
             std::string bw = tw + ".checks." + k;
             c.keys(b, bw, {"min", "max"});
@@ -221,17 +225,20 @@ struct TestEntry {
 };
 
 TestEntry parse_test(const Ctx& c, const json& t, const std::string& w, const Suite& suite, const SuiteDefaults& d) {
-    c.keys(t, w, {"scene", "method", "env", "size", "options", "variants", "baseline", "reference",
-                  "baseline_tolerances", "reference_band", "tags", "temporal", "stability", "max_cost_growth",
-                  "tolerance_note"});
+    c.keys(t, w,
+           {"scene", "method", "env", "size", "options", "variants", "baseline", "reference", "baseline_tolerances",
+            "reference_band", "tags", "temporal", "stability", "max_cost_growth", "tolerance_note"});
     if (t.contains("tolerance_note")) c.str(t["tolerance_note"], w + ".tolerance_note");
     if (!t.contains("scene")) c.fail(w + ".scene", "missing required key");
     if (!t.contains("method")) c.fail(w + ".method", "missing required key");
     TestEntry entry;
-    if (!t.contains("env")) entry.envs.push_back(d.env);
+    if (!t.contains("env"))
+        entry.envs.push_back(d.env);
     else if (t["env"].is_array())
-        for (size_t k = 0; k < t["env"].size(); ++k) entry.envs.push_back(c.str(t["env"][k], w + ".env[" + std::to_string(k) + "]"));
-    else entry.envs.push_back(c.str(t["env"], w + ".env"));
+        for (size_t k = 0; k < t["env"].size(); ++k)
+            entry.envs.push_back(c.str(t["env"][k], w + ".env[" + std::to_string(k) + "]"));
+    else
+        entry.envs.push_back(c.str(t["env"], w + ".env"));
     if (t.contains("options")) entry.base_opts = c.options(t["options"], w + ".options");
     if (t.contains("variants")) {
         if (!t["variants"].is_array()) c.fail(w + ".variants", "must be an array of option objects");
@@ -243,8 +250,8 @@ TestEntry parse_test(const Ctx& c, const json& t, const std::string& w, const Su
     TestCase& proto = entry.proto;
     proto.suite = suite.name;
     proto.suite_arg = suite.arg;
-    proto.max_cost_growth = t.contains("max_cost_growth") ? c.num(t["max_cost_growth"], w + ".max_cost_growth")
-                                                          : d.max_cost_growth;
+    proto.max_cost_growth =
+        t.contains("max_cost_growth") ? c.num(t["max_cost_growth"], w + ".max_cost_growth") : d.max_cost_growth;
     if (!(proto.max_cost_growth >= 0)) c.fail(w + ".max_cost_growth", "must be >= 0");
     proto.spec.scene = c.str(t["scene"], w + ".scene");
     proto.spec.method = c.str(t["method"], w + ".method");
@@ -256,16 +263,17 @@ TestEntry parse_test(const Ctx& c, const json& t, const std::string& w, const Su
     proto.baseline_tolerances = d.bounds;
     if (t.contains("baseline_tolerances"))
         for (auto& [k, v] : c.bounds(t["baseline_tolerances"], w + ".baseline_tolerances")) {
-            if (v.min || v.max) proto.baseline_tolerances[k] = v;
-            else proto.baseline_tolerances.erase(k);
+            if (v.min || v.max)
+                proto.baseline_tolerances[k] = v;
+            else
+                proto.baseline_tolerances.erase(k);
         }
     proto.reference_band = d.bands;
     if (t.contains("reference_band"))
         for (auto& [k, v] : c.bands(t["reference_band"], w + ".reference_band")) proto.reference_band[k] = v;
     if (t.contains("tags"))
         for (size_t k = 0; k < t["tags"].size(); ++k) proto.tags.push_back(c.str(t["tags"][k], w + ".tags"));
-    proto.stability = t.contains("stability") ? parse_stability(c, t["stability"], w + ".stability", d.stability)
-                                              : d.stability;
+    proto.stability = t.contains("stability") ? parse_stability(c, t["stability"], w + ".stability", d.stability) : d.stability;
     if (t.contains("temporal")) proto.temporal = parse_temporal(c, t["temporal"], w + ".temporal");
     return entry;
 }
@@ -318,8 +326,7 @@ Suite load_suite(const std::string& name_or_path) {
     suite.file = file;
     // A suite found by name is named again; one given by path is given by its absolute path, so
     // the bless command printed on failure works from any folder.
-    suite.arg = fs::path(name_or_path).extension() == ".json" ? fs::absolute(file).lexically_normal().string()
-                                                              : name_or_path;
+    suite.arg = fs::path(name_or_path).extension() == ".json" ? fs::absolute(file).lexically_normal().string() : name_or_path;
     suite.name = c.str(root["suite"], "suite");
     if (root.contains("description")) suite.description = c.str(root["description"], "description");
     const SuiteDefaults defaults = parse_defaults(c, root.value("defaults", json::object()), suite);

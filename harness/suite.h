@@ -42,7 +42,6 @@
 
 namespace iblcheck {
 
-
 // Temporal tests (animated scenes): every frame of the test, of the same scene with
 // specular_aa=off (the comparison) and of the reference sequence (the same shading, ssaa ×
 // reference_ssaa, specular_aa=off: a near-perfect pixel filter) is rendered and tone-mapped;
@@ -50,10 +49,10 @@ namespace iblcheck {
 // override the reference's options last (e.g. shading=compute: the fragment path's tests are
 // judged against the ray-traced, supersampled compute path).
 struct TemporalSpec {
-    int frames = 0;                       // 0: not a temporal test
+    int frames = 0; // 0: not a temporal test
     int reference_ssaa = 8;
     OptionMap reference_options;
-    std::map<std::string, Bound> checks;  // flicker, variation_ratio, flip_mean, flicker_ratio, flip_ratio
+    std::map<std::string, Bound> checks; // flicker, variation_ratio, flip_mean, flicker_ratio, flip_ratio
 };
 
 // Verdict stability (issue 9): determinism across repeats and lavapipe thread counts, noise floors
@@ -76,14 +75,14 @@ struct StabilitySpec {
 struct TestCase {
     std::string name;
     std::string suite;
-    std::string suite_arg;           // what `--suite` needs to find the suite again: its name, or its path
-    std::string variant;             // "default" or the canonical k=v list of all the test's options
+    std::string suite_arg; // what `--suite` needs to find the suite again: its name, or its path
+    std::string variant;   // "default" or the canonical k=v list of all the test's options
     TestSpec spec;
-    bool baseline = true;            // compare with approved baselines
-    bool reference = true;           // measure accuracy against the reference golden if one exists
+    bool baseline = true;  // compare with approved baselines
+    bool reference = true; // measure accuracy against the reference golden if one exists
     std::map<std::string, Bound> baseline_tolerances;
     std::map<std::string, Band> reference_band;
-    double max_cost_growth = 0.25;   // cost per pixel (SPIR-V instructions, texture fetches) vs the baseline's
+    double max_cost_growth = 0.25; // cost per pixel (SPIR-V instructions, texture fetches) vs the baseline's
     std::vector<std::string> tags;
     TemporalSpec temporal;
     StabilitySpec stability;
@@ -93,9 +92,9 @@ struct Suite {
     std::string name;
     std::string description;
     std::filesystem::path file;
-    std::string arg;                 // the suite's name, or the absolute path it was loaded from
+    std::string arg; // the suite's name, or the absolute path it was loaded from
     int jobs = 2;
-    int timing_repeats = 1;          // renders per test whose frame times give a median and range
+    int timing_repeats = 1; // renders per test whose frame times give a median and range
     std::vector<TestCase> tests;
 };
 

@@ -65,14 +65,15 @@ TemporalOutcome run_temporal(const TestCase& tc, Worker& w, const GoldenStore& s
         const SequenceScore tt = score_sequence(test_frames, truth_frames, flip_threads);
         const SequenceScore to = score_sequence(off_frames, truth_frames, flip_threads);
         const SequenceScore tr = score_sequence(ref_frames, truth_frames, flip_threads);
-        j["truth"] = {{"golden", store.relative(truth->image_path)},
-                      {"error_bound", truth->provenance.value("error_bound", json())},
-                      {"flicker", tt.flicker},
-                      {"variation_ratio", tt.variation_ratio},
-                      {"flip_mean", tt.flip_mean},
-                      {"off", {{"flicker", to.flicker}, {"variation_ratio", to.variation_ratio}, {"flip_mean", to.flip_mean}}},
-                      {"reference", {{"flicker", tr.flicker}, {"variation_ratio", tr.variation_ratio}, {"flip_mean", tr.flip_mean}}},
-                      {"flip_ratio", to.flip_mean > 0 ? tt.flip_mean / to.flip_mean : 1.0}};
+        j["truth"] = {
+            {"golden", store.relative(truth->image_path)},
+            {"error_bound", truth->provenance.value("error_bound", json())},
+            {"flicker", tt.flicker},
+            {"variation_ratio", tt.variation_ratio},
+            {"flip_mean", tt.flip_mean},
+            {"off", {{"flicker", to.flicker}, {"variation_ratio", to.variation_ratio}, {"flip_mean", to.flip_mean}}},
+            {"reference", {{"flicker", tr.flicker}, {"variation_ratio", tr.variation_ratio}, {"flip_mean", tr.flip_mean}}},
+            {"flip_ratio", to.flip_mean > 0 ? tt.flip_mean / to.flip_mean : 1.0}};
         j["truth_flicker"] = tt.flicker;
         j["truth_flip_mean"] = tt.flip_mean;
         j["truth_flip_ratio"] = j["truth"]["flip_ratio"];

@@ -19,7 +19,7 @@
 namespace iblcheck {
 
 struct TemporalOutcome {
-    nlohmann::json json;          // the test's "temporal" results object
+    nlohmann::json json; // the test's "temporal" results object
     std::vector<Check> checks;
 };
 

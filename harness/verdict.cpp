@@ -81,10 +81,10 @@ Check judge_band(const std::string& metric, double value, double approved, const
     if (!above && !below) return c;
     const bool worse = hib ? below : above;
     c.status = worse ? Verdict::fail : Verdict::improved;
-    c.message = worse ? fmt::format("{} {} outside [{}, {}] approved around {}", metric, num(value), num(lo), num(hi),
-                                    num(approved))
-                      : fmt::format("{} improved: {} beyond [{}, {}] approved around {}; tighten by re-blessing",
-                                    metric, num(value), num(lo), num(hi), num(approved));
+    c.message =
+        worse ? fmt::format("{} {} outside [{}, {}] approved around {}", metric, num(value), num(lo), num(hi), num(approved))
+              : fmt::format("{} improved: {} beyond [{}, {}] approved around {}; tighten by re-blessing", metric, num(value),
+                            num(lo), num(hi), num(approved));
     return c;
 }
 
@@ -100,8 +100,8 @@ Check judge_cost(const std::string& metric, double value, double approved, doubl
                                 100 * max_growth, percent_change(value, approved));
     } else if (value < lo) {
         c.status = Verdict::improved;
-        c.message = fmt::format("{} improved: {} < {} (approved {}): {}; lock it in by re-blessing", metric,
-                                num(value), num(lo), num(approved), percent_change(value, approved));
+        c.message = fmt::format("{} improved: {} < {} (approved {}): {}; lock it in by re-blessing", metric, num(value), num(lo),
+                                num(approved), percent_change(value, approved));
     }
     return c;
 }
@@ -182,8 +182,11 @@ size_t choose_baseline(const std::vector<Comparison>& candidates) {
 }
 
 json to_json(const Check& c) {
-    json j = {{"metric", c.metric}, {"value", std::isfinite(c.value) ? json(c.value) : json()},
-              {"min", optional_json(c.min)}, {"max", optional_json(c.max)}, {"status", verdict_name(c.status)}};
+    json j = {{"metric", c.metric},
+              {"value", std::isfinite(c.value) ? json(c.value) : json()},
+              {"min", optional_json(c.min)},
+              {"max", optional_json(c.max)},
+              {"status", verdict_name(c.status)}};
     if (c.approved) j["approved"] = std::isfinite(*c.approved) ? json(*c.approved) : json();
     if (!c.message.empty()) j["message"] = c.message;
     return j;

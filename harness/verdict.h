@@ -20,8 +20,8 @@ namespace iblcheck {
 // Ordered by severity: overall_verdict() keeps the worst.
 enum class Verdict { pass, improved, fail, missing_golden, error };
 
-std::string_view verdict_name(Verdict v);       // "pass", "improved", "fail", "missing-golden", "error"
-Verdict parse_verdict(std::string_view name);   // throws InputError on an unknown name
+std::string_view verdict_name(Verdict v);     // "pass", "improved", "fail", "missing-golden", "error"
+Verdict parse_verdict(std::string_view name); // throws InputError on an unknown name
 // A regression for CI and bisect: fail or missing-golden (exit 1). error is "cannot test" (exit 2).
 bool is_regression(Verdict v);
 
@@ -35,12 +35,12 @@ struct Band {
 };
 
 struct Check {
-    std::string metric;                // "flip.mean", "accuracy.flip.mean", "cost.spirv_instructions_per_pixel"
+    std::string metric; // "flip.mean", "accuracy.flip.mean", "cost.spirv_instructions_per_pixel"
     double value = 0;
-    std::optional<double> min, max;    // the interval the value had to lie in
-    std::optional<double> approved;    // bands and costs: the approved figure the interval is built on
-    Verdict status = Verdict::pass;    // pass, improved or fail
-    std::string message;               // empty on pass
+    std::optional<double> min, max; // the interval the value had to lie in
+    std::optional<double> approved; // bands and costs: the approved figure the interval is built on
+    Verdict status = Verdict::pass; // pass, improved or fail
+    std::string message;            // empty on pass
 };
 
 // Larger is better for SSIM and PSNR; smaller for FLIP and costs.
@@ -60,15 +60,15 @@ double metric_value(const nlohmann::json& metrics, const std::string& key);
 
 // One comparison of the render against one golden.
 struct Comparison {
-    std::string kind;                  // "baseline" or "reference"
-    std::string golden;                // path relative to the golden root
-    std::string label;                 // baseline@label, "" for the primary
-    nlohmann::json metrics;            // compare_images() output; null when the sizes differ
+    std::string kind;       // "baseline" or "reference"
+    std::string golden;     // path relative to the golden root
+    std::string label;      // baseline@label, "" for the primary
+    nlohmann::json metrics; // compare_images() output; null when the sizes differ
     std::vector<Check> checks;
     Verdict verdict = Verdict::pass;
-    std::string message;               // the failing checks, joined
-    nlohmann::json images;             // report images (test/golden/heatmap), set by the runner
-    nlohmann::json worst_block;        // {x, y, flip, sphere}: the worst 16x16 block, set by the runner
+    std::string message;        // the failing checks, joined
+    nlohmann::json images;      // report images (test/golden/heatmap), set by the runner
+    nlohmann::json worst_block; // {x, y, flip, sphere}: the worst 16x16 block, set by the runner
 };
 
 // Every tolerance of a baseline comparison. Sizes must match: a size mismatch is a failed "size"

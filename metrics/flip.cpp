@@ -14,8 +14,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <limits>
 #include <cstring>
+#include <limits>
 #include <stdexcept>
 #include <thread>
 #include <vector>
@@ -23,8 +23,8 @@
 #include "harness/common/errors.h"
 #include "metrics/flip/color_spaces.h"
 #include "metrics/flip/csf_filters.h"
-#include "metrics/flip/kernels.h"
 #include "metrics/flip/feature_detection.h"
+#include "metrics/flip/kernels.h"
 #include "metrics/flip/magma_table.h"
 #include "metrics/flip/parallel.h"
 #include "metrics/flip/pooling.h"
@@ -79,8 +79,7 @@ class FlipEngine {
         const int workers = std::min(threads_, int(items_.size()));
         auto work = [&](int t) {
             Scratch s(*this);
-            for (size_t i = size_t(t); i < items_.size(); i += size_t(workers))
-                run_item(prep, items_[i], s, out, max_merge);
+            for (size_t i = size_t(t); i < items_.size(); i += size_t(workers)) run_item(prep, items_[i], s, out, max_merge);
         };
         if (workers <= 1) {
             work(0);
@@ -190,8 +189,8 @@ class FlipEngine {
             column(img, kPCx, {&sf_.cx}, {1});
             column(img, kPCz1, {&sf_.cz1}, {2});
             column(img, kPCz2, {&sf_.cz2}, {3});
-            column(img, kPDx, {&ff_.g}, {4});          // d/dx: G'(x) G(y)
-            column(img, kPDdx, {&ff_.g}, {5});         // d2/dx2: G''(x) G(y)
+            column(img, kPDx, {&ff_.g}, {4});              // d/dx: G'(x) G(y)
+            column(img, kPDdx, {&ff_.g}, {5});             // d2/dx2: G''(x) G(y)
             column(img, kPG, {&ff_.dg, &ff_.ddg}, {6, 7}); // d/dy: G(x) G'(y); d2/dy2: G(x) G''(y)
         }
         k_.flip_pixels(q, n, cmax_, pccmax_, out + size_t(y) * w_ + it.x0, max_merge);
@@ -219,9 +218,8 @@ void check_pair(const cv::Mat& a, const cv::Mat& b, const char* what) {
     if (a.type() != CV_32FC3 || b.type() != CV_32FC3)
         throw InputError(std::string(what) + ": images must be CV_32FC3 (RGB float)");
     if (a.size() != b.size())
-        throw InputError(std::string(what) + ": size mismatch " + std::to_string(a.cols) + "x" +
-                         std::to_string(a.rows) + " vs " + std::to_string(b.cols) + "x" +
-                         std::to_string(b.rows));
+        throw InputError(std::string(what) + ": size mismatch " + std::to_string(a.cols) + "x" + std::to_string(a.rows) + " vs " +
+                         std::to_string(b.cols) + "x" + std::to_string(b.rows));
 }
 
 } // namespace
@@ -231,8 +229,7 @@ flip::ExposureRange flip_auto_exposure_range(const cv::Mat& ref_linear, flip::To
     lum.reserve(size_t(ref_linear.rows) * ref_linear.cols);
     for (int y = 0; y < ref_linear.rows; ++y) {
         const float* p = ref_linear.ptr<float>(y);
-        for (int x = 0; x < ref_linear.cols; ++x, p += 3)
-            lum.push_back(0.2126f * p[0] + 0.7152f * p[1] + 0.0722f * p[2]);
+        for (int x = 0; x < ref_linear.cols; ++x, p += 3) lum.push_back(0.2126f * p[0] + 0.7152f * p[1] + 0.0722f * p[2]);
     }
     return flip::auto_exposure_range(tm, std::move(lum));
 }
@@ -317,8 +314,8 @@ FlipResult compute_flip_hdr(const cv::Mat& ref_linear, const cv::Mat& test_linea
         stop = *opts.stop_exposure;
     }
     if (!(start <= stop))
-        throw UsageError("HDR-FLIP: start exposure (" + std::to_string(start) +
-                         ") must not exceed stop exposure (" + std::to_string(stop) + ")");
+        throw UsageError("HDR-FLIP: start exposure (" + std::to_string(start) + ") must not exceed stop exposure (" +
+                         std::to_string(stop) + ")");
     const int num = opts.num_exposures.value_or(auto_num_exposures(start, stop));
     if (num < 2) throw UsageError("HDR-FLIP: at least 2 exposures are needed");
     r.start_exposure = start;
@@ -371,8 +368,10 @@ void pool_flip_errmap(FlipResult& r) {
     r.mean = sum / double(n);
     r.min = mn;
     r.max = mx;
-    if (negative) std::sort(values.begin(), values.end()); // not a FLIP map; stay correct
-    else radix_sort_nonnegative(values);
+    if (negative)
+        std::sort(values.begin(), values.end()); // not a FLIP map; stay correct
+    else
+        radix_sort_nonnegative(values);
     const auto wp = weighted_percentiles_sorted<3>(values, sum_float, {0.5f, 0.25f, 0.75f});
     r.weighted_median = wp[0];
     r.weighted_q1 = wp[1];

@@ -28,7 +28,7 @@ struct Kernels;
 struct FlipOptions {
     double ppd = double(flip::kDefaultPpd); // pixels per degree of visual angle (67.0206451)
     flip::ToneMapper tone_mapper = flip::ToneMapper::aces;
-    std::optional<float> start_exposure;    // HDR: computed from the reference when absent
+    std::optional<float> start_exposure; // HDR: computed from the reference when absent
     std::optional<float> stop_exposure;
     std::optional<int> num_exposures;       // HDR: max(2, ceil(stop - start)) when absent
     int threads = 0;                        // 0: std::thread::hardware_concurrency()
@@ -36,16 +36,16 @@ struct FlipOptions {
 };
 
 struct FlipResult {
-    cv::Mat errmap;                 // CV_32F, per-pixel FLIP error in [0,1]
-    double mean = 0;                // summed in double, row order
-    double weighted_median = 0;     // the tool's histogram-weighted percentiles (flip/pooling.h)
+    cv::Mat errmap;             // CV_32F, per-pixel FLIP error in [0,1]
+    double mean = 0;            // summed in double, row order
+    double weighted_median = 0; // the tool's histogram-weighted percentiles (flip/pooling.h)
     double weighted_q1 = 0;
     double weighted_q3 = 0;
-    double p99 = 0;                 // plain 99th percentile (nearest rank)
+    double p99 = 0; // plain 99th percentile (nearest rank)
     double min = 0, max = 0;
-    double block_max = 0;           // largest mean over 16x16 blocks (edge blocks: the pixels they have)
-    int block_x = 0, block_y = 0;   // top-left pixel of that block
-    std::string mode;               // "ldr" or "hdr"
+    double block_max = 0;         // largest mean over 16x16 blocks (edge blocks: the pixels they have)
+    int block_x = 0, block_y = 0; // top-left pixel of that block
+    std::string mode;             // "ldr" or "hdr"
     double ppd = 0;
     double start_exposure = 0, stop_exposure = 0; // HDR only
     int num_exposures = 0;                        // HDR only (0 for LDR)
@@ -55,12 +55,10 @@ struct FlipResult {
 
 // LDR-FLIP. Inputs: CV_32FC3, RGB order, sRGB-encoded values in [0,1] (values outside are
 // clamped, as the tool does), same size.
-FlipResult compute_flip_ldr(const cv::Mat& ref_srgb, const cv::Mat& test_srgb,
-                            const FlipOptions& opts = {});
+FlipResult compute_flip_ldr(const cv::Mat& ref_srgb, const cv::Mat& test_srgb, const FlipOptions& opts = {});
 
 // HDR-FLIP. Inputs: CV_32FC3, RGB order, linear radiance (non-negative), same size.
-FlipResult compute_flip_hdr(const cv::Mat& ref_linear, const cv::Mat& test_linear,
-                            const FlipOptions& opts = {});
+FlipResult compute_flip_hdr(const cv::Mat& ref_linear, const cv::Mat& test_linear, const FlipOptions& opts = {});
 
 // Fills every statistic of `r` from r.errmap (mean, percentiles, min/max, 16x16 block maximum).
 void pool_flip_errmap(FlipResult& r);

@@ -38,19 +38,23 @@ std::optional<RawImage> read_exr(const std::string& path) {
         std::vector<std::string> names;
         for (auto it = cl.begin(); it != cl.end(); ++it) {
             // Subsampled channels (luminance/chroma files) and integer channels: OpenImageIO's job.
-            if (it.channel().xSampling != 1 || it.channel().ySampling != 1 || it.channel().type == Imf::UINT)
-                return std::nullopt;
+            if (it.channel().xSampling != 1 || it.channel().ySampling != 1 || it.channel().type == Imf::UINT) return std::nullopt;
             names.push_back(it.name());
         }
         // OpenEXR stores channel names sorted (B, G, R); the harness reads them as OpenImageIO
         // orders them: R, G, B, then A; Y, then A.
         std::vector<std::string> order;
         auto has = [&](const char* n) { return cl.findChannel(n) != nullptr; };
-        if (names.size() == 3 && has("R") && has("G") && has("B")) order = {"R", "G", "B"};
-        else if (names.size() == 4 && has("R") && has("G") && has("B") && has("A")) order = {"R", "G", "B", "A"};
-        else if (names.size() == 1 && has("Y")) order = {"Y"};
-        else if (names.size() == 2 && has("Y") && has("A")) order = {"Y", "A"};
-        else return std::nullopt;
+        if (names.size() == 3 && has("R") && has("G") && has("B"))
+            order = {"R", "G", "B"};
+        else if (names.size() == 4 && has("R") && has("G") && has("B") && has("A"))
+            order = {"R", "G", "B", "A"};
+        else if (names.size() == 1 && has("Y"))
+            order = {"Y"};
+        else if (names.size() == 2 && has("Y") && has("A"))
+            order = {"Y", "A"};
+        else
+            return std::nullopt;
 
         RawImage img;
         img.width = dw.max.x - dw.min.x + 1;

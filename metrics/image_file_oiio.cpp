@@ -55,8 +55,7 @@ void load_plugin() {
 const Plugin& plugin(const std::string& path) {
     std::call_once(g_once, load_plugin);
     if (!g_loaded)
-        throw EnvironmentError(fmt::format("{}: this format is read through OpenImageIO, but {}", path,
-                                           g_plugin.problem));
+        throw EnvironmentError(fmt::format("{}: this format is read through OpenImageIO, but {}", path, g_plugin.problem));
     return g_plugin;
 }
 
@@ -91,11 +90,9 @@ RawImage read_with_oiio(const std::string& path, bool unassociated_alpha) {
     const int rc = p.read(path.c_str(), unassociated_alpha ? 1 : 0, &out);
     const std::string why = out.error;
     if (rc == kOiioCannotOpen)
-        throw InputError(fmt::format("{}: cannot read image ({})", path,
-                                     why.empty() ? "unknown format or corrupt file" : why));
+        throw InputError(fmt::format("{}: cannot read image ({})", path, why.empty() ? "unknown format or corrupt file" : why));
     if (rc != kOiioOk)
-        throw InputError(fmt::format("{}: corrupt or truncated image data ({})", path,
-                                     why.empty() ? "read failed" : why));
+        throw InputError(fmt::format("{}: corrupt or truncated image data ({})", path, why.empty() ? "read failed" : why));
     img.width = out.width;
     img.height = out.height;
     img.channels = out.channels;
@@ -104,8 +101,7 @@ RawImage read_with_oiio(const std::string& path, bool unassociated_alpha) {
     return img;
 }
 
-void write_with_oiio(const std::string& path, int width, int height, int channels, bool is_float,
-                     const void* data) {
+void write_with_oiio(const std::string& path, int width, int height, int channels, bool is_float, const void* data) {
     const Plugin& p = plugin(path);
     char error[1024] = "";
     const int rc = p.write(path.c_str(), width, height, channels, is_float ? 1 : 0, data, error, sizeof error);

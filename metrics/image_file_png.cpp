@@ -72,9 +72,8 @@ bool png_pixels(png_structp png, png_infop info, png_bytepp rows) {
 bool png_write(png_structp png, png_infop info, FILE* f, int w, int h, int channels, png_bytepp rows) {
     if (setjmp(png_jmpbuf(png))) return false;
     png_init_io(png, f);
-    png_set_IHDR(png, info, png_uint_32(w), png_uint_32(h), 8,
-                 channels == 1 ? PNG_COLOR_TYPE_GRAY : PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
-                 PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+    png_set_IHDR(png, info, png_uint_32(w), png_uint_32(h), 8, channels == 1 ? PNG_COLOR_TYPE_GRAY : PNG_COLOR_TYPE_RGB,
+                 PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
     png_write_info(png, info);
     png_write_image(png, rows);
     png_write_end(png, nullptr);
@@ -100,8 +99,7 @@ RawImage read_png(const std::string& path) {
     } destroy{&png, &info};
 
     PngInfo hdr;
-    if (!png_header(png, info, f.get(), &hdr))
-        throw InputError(fmt::format("{}: cannot read image ({})", path, err.message));
+    if (!png_header(png, info, f.get(), &hdr)) throw InputError(fmt::format("{}: cannot read image ({})", path, err.message));
     RawImage img;
     img.width = int(hdr.width);
     img.height = int(hdr.height);
@@ -139,8 +137,7 @@ void write_png(const std::string& path, int width, int height, int channels, con
         throw InputError(fmt::format("{}: cannot open for writing (libpng: out of memory)", path));
     }
     std::vector<png_bytep> rows(static_cast<size_t>(height));
-    for (int y = 0; y < height; ++y)
-        rows[size_t(y)] = const_cast<png_bytep>(data + size_t(y) * width * channels);
+    for (int y = 0; y < height; ++y) rows[size_t(y)] = const_cast<png_bytep>(data + size_t(y) * width * channels);
     const bool ok = png_write(png, info, f.get(), width, height, channels, rows.data());
     png_destroy_write_struct(&png, &info);
     if (!ok) throw InputError(fmt::format("{}: write failed ({})", path, err.message));

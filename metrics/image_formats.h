@@ -16,9 +16,9 @@ namespace iblcheck::imagefile {
 // Decoded pixels before the harness's conventions (RGB, alpha dropped) are applied.
 struct RawImage {
     int width = 0, height = 0, channels = 0;
-    bool hdr = false;         // float data (EXR, Radiance HDR, float TIFF); false: integer codes
-    std::vector<float> data;  // row-major, channels interleaved; integer codes as k / (2^bits - 1)
-    std::string reader;       // "openexr", "libpng" or "openimageio" (tests check which one ran)
+    bool hdr = false;        // float data (EXR, Radiance HDR, float TIFF); false: integer codes
+    std::vector<float> data; // row-major, channels interleaved; integer codes as k / (2^bits - 1)
+    std::string reader;      // "openexr", "libpng" or "openimageio" (tests check which one ran)
 };
 
 // Any image file: OpenEXR (known channel layouts) and PNG natively, everything else through the
@@ -48,8 +48,7 @@ void write_exr(const std::string& path, int width, int height, int channels, con
 // 8-bit PNG, RGB (3) or grey (1).
 void write_png(const std::string& path, int width, int height, int channels, const uint8_t* data);
 // Any format OpenImageIO chooses from the file name; data is float (is_float) or 8-bit.
-void write_with_oiio(const std::string& path, int width, int height, int channels, bool is_float,
-                     const void* data);
+void write_with_oiio(const std::string& path, int width, int height, int channels, bool is_float, const void* data);
 
 // Where the plugin is looked for: beside the running executable, then the build folder.
 std::vector<std::string> oiio_plugin_candidates();

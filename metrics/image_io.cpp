@@ -33,16 +33,13 @@ Format sniff_format(const std::string& path) {
 RawImage read_raw(const std::string& path, bool unassociated_alpha) {
     std::error_code ec;
     if (!std::filesystem::exists(path, ec)) throw InputError(fmt::format("{}: file not found", path));
-    if (std::filesystem::is_directory(path, ec))
-        throw InputError(fmt::format("{}: is a directory, not an image", path));
+    if (std::filesystem::is_directory(path, ec)) throw InputError(fmt::format("{}: is a directory, not an image", path));
     switch (sniff_format(path)) {
     case Format::exr:
         if (std::optional<RawImage> img = read_exr(path)) return std::move(*img);
         break; // a channel layout OpenImageIO orders its own way
-    case Format::png:
-        return read_png(path);
-    case Format::other:
-        break;
+    case Format::png: return read_png(path);
+    case Format::other: break;
     }
     return read_with_oiio(path, unassociated_alpha);
 }
@@ -52,10 +49,8 @@ LoadedImage read_image(const std::string& path) {
     // PNG's alpha is unassociated by definition: the colour is read as stored.
     imagefile::RawImage raw = imagefile::read_raw(path, true);
     const int nch = raw.channels;
-    if (raw.width <= 0 || raw.height <= 0)
-        throw InputError(fmt::format("{}: image has no pixels", path));
-    if (nch < 1 || nch > 4)
-        throw InputError(fmt::format("{}: unsupported channel count {} (expected 1-4)", path, nch));
+    if (raw.width <= 0 || raw.height <= 0) throw InputError(fmt::format("{}: image has no pixels", path));
+    if (nch < 1 || nch > 4) throw InputError(fmt::format("{}: unsupported channel count {} (expected 1-4)", path, nch));
 
     LoadedImage li;
     li.path = path;
@@ -168,11 +163,9 @@ size_t clamp_negative(cv::Mat& mat) {
     return count;
 }
 
-void check_same_size(const cv::Mat& a, const cv::Mat& b, const std::string& path_a,
-                     const std::string& path_b) {
+void check_same_size(const cv::Mat& a, const cv::Mat& b, const std::string& path_a, const std::string& path_b) {
     if (a.size() != b.size())
-        throw InputError(fmt::format("{}: size {}x{} does not match {} ({}x{})", path_b, b.cols,
-                                     b.rows, path_a, a.cols, a.rows));
+        throw InputError(fmt::format("{}: size {}x{} does not match {} ({}x{})", path_b, b.cols, b.rows, path_a, a.cols, a.rows));
 }
 
 } // namespace iblcheck

@@ -11,9 +11,9 @@
 namespace iblcheck {
 
 struct LoadedImage {
-    cv::Mat pixels;         // CV_32FC3, RGB
-    bool hdr = false;       // true: linear float data (EXR/HDR/float TIFF); false: sRGB in [0,1]
-    int file_channels = 0;  // channels in the file before dropping alpha / expanding grey
+    cv::Mat pixels;        // CV_32FC3, RGB
+    bool hdr = false;      // true: linear float data (EXR/HDR/float TIFF); false: sRGB in [0,1]
+    int file_channels = 0; // channels in the file before dropping alpha / expanding grey
     bool has_alpha() const { return file_channels == 2 || file_channels == 4; }
     std::string path;
 };
@@ -45,7 +45,6 @@ size_t count_negative(const cv::Mat& mat);
 // Clamps negative values to 0 in place; returns how many were changed.
 size_t clamp_negative(cv::Mat& mat);
 // Throws InputError naming both files when the sizes differ.
-void check_same_size(const cv::Mat& a, const cv::Mat& b, const std::string& path_a,
-                     const std::string& path_b);
+void check_same_size(const cv::Mat& a, const cv::Mat& b, const std::string& path_a, const std::string& path_b);
 
 } // namespace iblcheck

@@ -30,8 +30,7 @@ PsnrResult compute_psnr(const cv::Mat& ref, const cv::Mat& test, double data_ran
     res.mse = sse / (double(ref.total()) * ref.channels());
     res.rmse = std::sqrt(res.mse);
     res.max_abs = max_abs;
-    res.db = res.mse == 0.0 ? std::numeric_limits<double>::infinity()
-                            : 10.0 * std::log10(data_range * data_range / res.mse);
+    res.db = res.mse == 0.0 ? std::numeric_limits<double>::infinity() : 10.0 * std::log10(data_range * data_range / res.mse);
     return res;
 }
 

@@ -5,10 +5,10 @@
 namespace iblcheck {
 
 struct PsnrResult {
-    double db = 0;       // 10 log10(range^2 / MSE); +inf for identical images
+    double db = 0; // 10 log10(range^2 / MSE); +inf for identical images
     double mse = 0;
     double rmse = 0;
-    double max_abs = 0;  // largest |test - ref| over all channel values
+    double max_abs = 0; // largest |test - ref| over all channel values
 };
 
 // PSNR with data range 1 (display values in [0,1]), as scikit-image's

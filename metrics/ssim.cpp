@@ -21,8 +21,7 @@ cv::Mat blur(const cv::Mat& m, const cv::Mat& k) {
 SsimResult compute_ssim(const cv::Mat& a, const cv::Mat& b) {
     if (a.type() != CV_32FC3 || b.type() != CV_32FC3 || a.size() != b.size())
         throw InputError("SSIM: inputs must be CV_32FC3 of the same size");
-    if (a.cols < 2 * kRadius + 1 || a.rows < 2 * kRadius + 1)
-        throw InputError("SSIM: images must be at least 11x11");
+    if (a.cols < 2 * kRadius + 1 || a.rows < 2 * kRadius + 1) throw InputError("SSIM: images must be at least 11x11");
     // Normalised Gaussian taps (what scipy.ndimage.gaussian_filter uses).
     cv::Mat k = cv::getGaussianKernel(2 * kRadius + 1, kSigma, CV_64F);
     const double c1 = (kK1 * kL) * (kK1 * kL), c2 = (kK2 * kL) * (kK2 * kL);
@@ -45,8 +44,7 @@ SsimResult compute_ssim(const cv::Mat& a, const cv::Mat& b) {
                 const double mx = px[i], my = py[i];
                 const double vx = pxx[i] - mx * mx, vy = pyy[i] - my * my, vxy = pxy[i] - mx * my;
                 // Eq. 13 of Wang et al. 2004.
-                sum += ((2 * mx * my + c1) * (2 * vxy + c2)) /
-                       ((mx * mx + my * my + c1) * (vx + vy + c2));
+                sum += ((2 * mx * my + c1) * (2 * vxy + c2)) / ((mx * mx + my * my + c1) * (vx + vy + c2));
             }
         }
         r.per_channel[c] = sum / double(valid.area());

@@ -15,7 +15,7 @@ inline constexpr int kSsimMinSize = 11;
 inline bool ssim_applicable(const cv::Mat& m) { return m.cols >= kSsimMinSize && m.rows >= kSsimMinSize; }
 
 struct SsimResult {
-    double mean = 0;              // mean over channels of the per-channel mean SSIM
+    double mean = 0; // mean over channels of the per-channel mean SSIM
     double per_channel[3] = {0, 0, 0};
 };
 

@@ -10,13 +10,12 @@ namespace iblcheck {
 
 TemporalResult compute_temporal(const std::vector<cv::Mat>& test, const std::vector<cv::Mat>& ref) {
     if (test.size() != ref.size())
-        throw InputError("temporal: " + std::to_string(test.size()) + " test frames but " +
-                         std::to_string(ref.size()) + " reference frames");
+        throw InputError("temporal: " + std::to_string(test.size()) + " test frames but " + std::to_string(ref.size()) +
+                         " reference frames");
     if (test.size() < 2) throw InputError("temporal: at least 2 frames are needed");
     for (size_t t = 0; t < test.size(); ++t) {
-        if (test[t].depth() != CV_32F || test[t].type() != ref[t].type() ||
-            test[t].size() != ref[t].size() || test[t].size() != test[0].size() ||
-            test[t].type() != test[0].type())
+        if (test[t].depth() != CV_32F || test[t].type() != ref[t].type() || test[t].size() != ref[t].size() ||
+            test[t].size() != test[0].size() || test[t].type() != test[0].type())
             throw InputError("temporal: frame " + std::to_string(t) +
                              " differs in size or type from the others (float frames needed)");
     }
@@ -40,8 +39,10 @@ TemporalResult compute_temporal(const std::vector<cv::Mat>& test, const std::vec
     TemporalResult r;
     r.frames = int(test.size());
     r.flicker = flicker / double(count);
-    if (var_r > 0.0) r.variation_ratio = var_t / var_r;
-    else r.variation_ratio = var_t > 0.0 ? std::numeric_limits<double>::infinity() : 1.0;
+    if (var_r > 0.0)
+        r.variation_ratio = var_t / var_r;
+    else
+        r.variation_ratio = var_t > 0.0 ? std::numeric_limits<double>::infinity() : 1.0;
     return r;
 }
 

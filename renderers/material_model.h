@@ -49,8 +49,6 @@ inline double f_schlick(double f0, double v_dot_h) {
     return f0 + (1.0 - f0) * x2 * x2 * x;
 }
 
-inline double f0_from(double base_color, double metallic) {
-    return kDielectricF0 * (1.0 - metallic) + base_color * metallic;
-}
+inline double f0_from(double base_color, double metallic) { return kDielectricF0 * (1.0 - metallic) + base_color * metallic; }
 
 } // namespace iblcheck::model

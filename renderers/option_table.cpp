@@ -21,7 +21,8 @@ const std::vector<OptionInfo>& option_catalog() {
         {"camera_shift", "0", "pixels x,y,0", "all", "", "stability: moves the camera by a fraction of a pixel"},
         {"bump_frequency", "200", ">0", "all", "", "spatial frequency of the bumpy_sphere normal detail (radius-1 units)"},
         {"ao", "1", "0..1", "mobile", "",
-         "material ambient occlusion of every sphere: multiplies its diffuse lighting and indirect_irradiance (UE4; so, under a normalisation, its reflections)"},
+         "material ambient occlusion of every sphere: multiplies its diffuse lighting and indirect_irradiance (UE4; so, under a "
+         "normalisation, its reflections)"},
         {"ssaa", "2 (shading=fragment: 1)", "1..16", "mobile,sampled", "",
          "n x n rays per pixel (silhouettes); shading=fragment: renders n x n times the pixels and averages them"},
         {"cube_size", "128 (sampled: 256)", "8..2048, power of two", "mobile,sampled", "", "base size of the cubemaps"},
@@ -36,21 +37,25 @@ const std::vector<OptionInfo>& option_catalog() {
         {"diffuse", "sh9", "sh9|irradiance_cube", "mobile", "DIFFUSE", "diffuse irradiance representation"},
         {"dominant_dir", "off", "off|lagarde|filament", "mobile", "DOMINANT_DIR", "specular dominant direction"},
         {"normalization", "off", "off|ue4|directional", "mobile", "NORMALIZATION",
-         "UE4 mobile reflection normalisation (MixingAlpha); directional: the ratio at n (SH9 E(n) / the prefiltered chain's at n) instead of UE4's scalar one"},
+         "UE4 mobile reflection normalisation (MixingAlpha); directional: the ratio at n (SH9 E(n) / the prefiltered chain's at "
+         "n) instead of UE4's scalar one"},
         {"mix_begin_roughness", "0.1", "0..1", "mobile", "", "normalisation: roughness where mixing starts"},
         {"mix_end_roughness", "0.3", "0..1", "mobile", "", "normalisation: roughness where mixing is full"},
         {"mix_largest_weight", "10000", ">0", "mobile", "", "normalisation: clamp of the mixing weight"},
         {"indirect_irradiance", "sh9", "sh9 or a number", "mobile", "", "normalisation: lightmap/ILC brightness"},
         {"storage", "rgba16f", "rgba16f|rgba32f|rgbm8|r11g11b10|astc_hdr|astc_ldr_rgbm", "mobile", "STORAGE",
          "prefiltered cube storage; astc_*: encoded and decoded on the CPU by astcenc (libastcenc-dev), see astc_block"},
-        {"astc_block", "4x4", "4x4|6x6", "mobile", "", "ASTC block footprint (storage=astc_*): 4x4 = 8 bits per texel, 6x6 = 3.56"},
+        {"astc_block", "4x4", "4x4|6x6", "mobile", "",
+         "ASTC block footprint (storage=astc_*): 4x4 = 8 bits per texel, 6x6 = 3.56"},
         {"rgbm_range", "6", ">0", "mobile", "", "RGBM range (storage=rgbm8, astc_ldr_rgbm)"},
         {"env_layout", "cube", "cube|octahedral|equirect", "mobile", "ENV_LAYOUT",
-         "layout of the prefiltered radiance: a cubemap (NxN x6) or one 2D texture, octahedral (2Nx2N) or lat-long (4Nx2N), with a 1-texel border per level"},
+         "layout of the prefiltered radiance: a cubemap (NxN x6) or one 2D texture, octahedral (2Nx2N) or lat-long (4Nx2N), with "
+         "a 1-texel border per level"},
         {"precision", "highp", "highp|mediump", "mobile", "PRECISION", "mediump shades in float16_t"},
         {"fp16", "auto", "auto|native|emulated", "mobile", "",
          "precision=mediump: native float16_t, or emulated (fp32 rounded to fp16 per operation); auto: native if shaderFloat16"},
-        {"specular_aa", "off", "off|tokuyoshi|rjump|toksvig", "mobile", "SPECULAR_AA", "specular anti-aliasing for low roughness"},
+        {"specular_aa", "off", "off|tokuyoshi|rjump|toksvig", "mobile", "SPECULAR_AA",
+         "specular anti-aliasing for low roughness"},
         {"specular_aa_variance", "0.25", ">=0", "mobile", "", "specular AA: screen-space variance scale"},
         {"specular_aa_threshold", "0.18", ">=0", "mobile", "", "specular AA: clamp of the added roughness"},
         {"samples", "64", "1..65536", "sampled", "", "GGX samples per ray"},
@@ -101,7 +106,8 @@ std::string option_choice(const OptionMap& o, const std::string& key) {
 
 std::string glsl_value_name(const OptionInfo& info, const std::string& value) {
     std::string name = info.glsl_define + "_";
-    for (char c : value) name += std::isalnum(static_cast<unsigned char>(c)) ? char(std::toupper(static_cast<unsigned char>(c))) : '_';
+    for (char c : value)
+        name += std::isalnum(static_cast<unsigned char>(c)) ? char(std::toupper(static_cast<unsigned char>(c))) : '_';
     return name;
 }
 

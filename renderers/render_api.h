@@ -14,22 +14,22 @@ struct TestSpec {
     std::string scene = "sphere";
     std::string method = "mobile"; // mobile | sampled | reference
     std::string env = "studio";
-    int width = 0, height = 0;     // 0: the scene's default size
-    OptionMap options;             // material + method variants, one spelling everywhere
-    int frame = 0;                 // temporal scenes: frame index
+    int width = 0, height = 0; // 0: the scene's default size
+    OptionMap options;         // material + method variants, one spelling everywhere
+    int frame = 0;             // temporal scenes: frame index
 };
 
 struct PassTiming {
-    std::string name;   // "equirect_to_cube", "prefilter_ggx", "shade_spheres", "reference_cpu", ...
+    std::string name; // "equirect_to_cube", "prefilter_ggx", "shade_spheres", "reference_cpu", ...
     double ms = 0;
-    bool gpu = false;   // true: timestamp queries; false: steady clock on the CPU
+    bool gpu = false;        // true: timestamp queries; false: steady clock on the CPU
     bool precompute = false; // environment-dependent work done once (prefilter, SH, LUT)
 };
 
 struct RenderResult {
-    cv::Mat image;                    // CV_32FC3, linear HDR
+    cv::Mat image; // CV_32FC3, linear HDR
     std::vector<PassTiming> timings;
-    nlohmann::json provenance;        // method, driver, shader hash, samples, seeds, ...
+    nlohmann::json provenance;            // method, driver, shader hash, samples, seeds, ...
     double texture_fetches_per_pixel = 0; // driver-independent cost estimate
     // Dynamic SPIR-V instructions the frame's shading dispatch executed per image pixel, every ssaa
     // ray included (renderers/vulkan/spirv_cost.h): deterministic, unlike the timings. 0 for the

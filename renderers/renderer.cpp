@@ -39,7 +39,7 @@ void validate_spec(const TestSpec& spec) {
     // it is loaded, not halfway through a run.
     for (auto& o : option_catalog())
         if (o.enumerated() && spec.options.has(o.key)) option_choice(spec.options, o.key);
-    build_scene(spec.scene, spec.options);  // unknown scene or bad material option: UsageError
+    build_scene(spec.scene, spec.options); // unknown scene or bad material option: UsageError
 }
 
 Renderer::Renderer(vk::ContextOptions options) : options_(std::move(options)) {}
@@ -61,7 +61,7 @@ nlohmann::json Renderer::driver_json() {
     if (!gpu_) return nlohmann::json::object();
     const auto& i = gpu_->ctx().info();
     return {{"device", i.device_name}, {"driver", i.driver_name}, {"driver_info", i.driver_info},
-            {"mesa", i.mesa_version}, {"llvm", i.llvm_version}, {"api", i.api_version}};
+            {"mesa", i.mesa_version},  {"llvm", i.llvm_version},  {"api", i.api_version}};
 }
 
 RenderResult Renderer::render(const TestSpec& spec) {
@@ -73,7 +73,8 @@ RenderResult Renderer::render(const TestSpec& spec) {
         if (!uses_quadrature(spec))
             for (const Sphere& s : build_scene(spec.scene, spec.options).spheres)
                 if (s.bump_amplitude > 0)
-                    throw UsageError("scene " + spec.scene + ": the Monte Carlo integrator models no normal detail; "
+                    throw UsageError("scene " + spec.scene +
+                                     ": the Monte Carlo integrator models no normal detail; "
                                      "the quadrature truth does (drop spp / integrator=monte_carlo)");
         r = render_reference(spec, env);
     } else if (spec.method == "mobile") {

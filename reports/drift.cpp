@@ -15,8 +15,8 @@ std::string percent(double from, double to) {
 }
 } // namespace
 
-std::optional<Flag> accuracy_flag(const std::vector<std::optional<double>>& values,
-                                  const std::vector<std::string>& commits, double noise_floor) {
+std::optional<Flag> accuracy_flag(const std::vector<std::optional<double>>& values, const std::vector<std::string>& commits,
+                                  double noise_floor) {
     std::vector<size_t> idx;
     for (size_t i = 0; i < values.size(); ++i)
         if (values[i] && std::isfinite(*values[i])) idx.push_back(i);
@@ -33,18 +33,18 @@ std::optional<Flag> accuracy_flag(const std::vector<std::optional<double>>& valu
     if (!best) {
         const double a = *values[idx.front()], b = *values[idx.back()];
         if (std::fabs(b - a) > floor)
-            best = Flag{idx.back(), a, b,
-                        fmt::format("{} over {} runs since {}", percent(a, b), idx.size(), commit(idx.front()))};
+            best =
+                Flag{idx.back(), a, b, fmt::format("{} over {} runs since {}", percent(a, b), idx.size(), commit(idx.front()))};
     }
     if (best) best->text += floor > 0 ? fmt::format(" (noise floor {:.2g})", floor) : std::string(" (no noise floor recorded)");
     return best;
 }
 
-std::optional<Flag> timing_flag(const std::vector<std::optional<Spread>>& spreads,
-                                const std::vector<std::string>& commits, size_t window) {
+std::optional<Flag> timing_flag(const std::vector<std::optional<Spread>>& spreads, const std::vector<std::string>& commits,
+                                size_t window) {
     std::optional<Flag> best;
     double best_move = 0;
-    std::vector<size_t> seen;  // present runs so far
+    std::vector<size_t> seen; // present runs so far
     for (size_t i = 0; i < spreads.size(); ++i) {
         if (!spreads[i]) continue;
         const Spread& s = *spreads[i];
@@ -56,14 +56,16 @@ std::optional<Flag> timing_flag(const std::vector<std::optional<Spread>>& spread
             // series (likely one run in n) is not a change.
             double move = 0, from = 0;
             const double width = hi - lo;
-            if (s.lo > hi && s.median - hi > width) move = (s.median - hi) / hi, from = hi;
-            else if (s.hi < lo && lo - s.median > width) move = (s.median - lo) / lo, from = lo;
+            if (s.lo > hi && s.median - hi > width)
+                move = (s.median - hi) / hi, from = hi;
+            else if (s.hi < lo && lo - s.median > width)
+                move = (s.median - lo) / lo, from = lo;
             if (move != 0 && std::isfinite(move) && std::fabs(move) > std::fabs(best_move)) {
                 best_move = move;
                 const std::string c = i < commits.size() ? commits[i] : "run " + std::to_string(i + 1);
-                best = Flag{i, from, s.median,
-                            fmt::format("{} at {} (outside the {:.3g}\u2013{:.3g} measured before)", percent(from, s.median),
-                                        c, lo, hi)};
+                best = Flag{
+                    i, from, s.median,
+                    fmt::format("{} at {} (outside the {:.3g}\u2013{:.3g} measured before)", percent(from, s.median), c, lo, hi)};
             }
         }
         seen.push_back(i);

@@ -15,27 +15,27 @@
 namespace iblcheck::report {
 
 struct Flag {
-    size_t index = 0;   // the run that made the change (into the series)
+    size_t index = 0; // the run that made the change (into the series)
     double from = 0, to = 0;
-    std::string text;   // "+3.1 % at c4 (noise floor 0.0017)"
+    std::string text; // "+3.1 % at c4 (noise floor 0.0017)"
 };
 
 // `values`: one per run, oldest first (absent: the test did not run). The largest step between
 // consecutive present values whose size exceeds `noise_floor` is flagged at the later run; when
 // no single step does, a drift from the first to the last value beyond the floor is flagged at
 // the last run. `commits` names the runs.
-std::optional<Flag> accuracy_flag(const std::vector<std::optional<double>>& values,
-                                  const std::vector<std::string>& commits, double noise_floor);
+std::optional<Flag> accuracy_flag(const std::vector<std::optional<double>>& values, const std::vector<std::string>& commits,
+                                  double noise_floor);
 
 struct Spread {
-    double lo = 0, median = 0, hi = 0;  // of one run's repeated timings (one timing: all equal)
+    double lo = 0, median = 0, hi = 0; // of one run's repeated timings (one timing: all equal)
 };
 
 // `spreads`: one per run, oldest first. A run is flagged when its [lo, hi] lies outside the hull of
 // the (at most `window`) present runs before it, its median is farther from the hull than the hull
 // is wide, and at least two runs came before it; of the flagged runs the one whose median moved
 // most (relative to the hull) is returned.
-std::optional<Flag> timing_flag(const std::vector<std::optional<Spread>>& spreads,
-                                const std::vector<std::string>& commits, size_t window = 10);
+std::optional<Flag> timing_flag(const std::vector<std::optional<Spread>>& spreads, const std::vector<std::string>& commits,
+                                size_t window = 10);
 
 } // namespace iblcheck::report

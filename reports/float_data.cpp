@@ -11,8 +11,8 @@
 
 #include "harness/common/errors.h"
 #include "harness/common/hash.h"
-#include "metrics/flip/tone_mappers.h"
 #include "metrics/display_transform.h"
+#include "metrics/flip/tone_mappers.h"
 #include "metrics/image_io.h"
 
 namespace iblcheck::report {
@@ -119,8 +119,9 @@ std::string DataStore::write(const std::string& meta_json, const std::string& pa
     const std::string key = fmt::format("{:016x}", content_hash);
     const fs::path file = out_dir_ / "data" / (key + ".js");
     std::error_code ec;
-    if (!keys_.insert(key).second) return key;  // same content: written by this report already
-    if (fs::exists(file, ec)) return key;        // an earlier report into this folder wrote it  // same content: written by this report already
+    if (!keys_.insert(key).second) return key; // same content: written by this report already
+    if (fs::exists(file, ec))
+        return key; // an earlier report into this folder wrote it  // same content: written by this report already
     fs::create_directories(file.parent_path(), ec);
     const fs::path tmp = file.string() + ".tmp";
     {
@@ -152,7 +153,7 @@ std::optional<FloatImageInfo> DataStore::image(const std::string& exr_rel) {
         try {
             LoadedImage li = read_image(src.string());
             cv::Mat m = li.pixels;
-            if (li.file_channels == 1) cv::extractChannel(li.pixels, m, 0);  // an error map
+            if (li.file_channels == 1) cv::extractChannel(li.pixels, m, 0); // an error map
             const std::vector<uint16_t> half = to_half(m);
             FloatImageInfo fi;
             fi.width = m.cols;
@@ -181,7 +182,7 @@ std::optional<FloatImageInfo> DataStore::image(const std::string& exr_rel) {
             fi.key = write(meta, pack_half(half), h.value());
             info = fi;
         } catch (const InputError&) {
-            info.reset();  // an unreadable EXR: the page keeps the PNG
+            info.reset(); // an unreadable EXR: the page keeps the PNG
         }
     }
     images_[exr_rel] = info;
@@ -209,9 +210,9 @@ std::optional<std::string> DataStore::id_map(const std::string& png_rel, const n
             h.update(ids.data(), ids.size());
             const std::string sp = spheres.dump();
             h.update(sp);
-            key = write(fmt::format("{{\"w\":{},\"h\":{},\"c\":1,\"enc\":\"u8\",\"spheres\":{}}}", li.pixels.cols,
-                                    li.pixels.rows, sp),
-                        pack_bytes(ids), h.value());
+            key = write(
+                fmt::format("{{\"w\":{},\"h\":{},\"c\":1,\"enc\":\"u8\",\"spheres\":{}}}", li.pixels.cols, li.pixels.rows, sp),
+                pack_bytes(ids), h.value());
         } catch (const InputError&) {
             key.reset();
         }
@@ -230,8 +231,11 @@ std::optional<std::string> DataStore::thumbnail(const std::string& exr_rel, int 
         const double ev = auto_exposure(m);
         const double s = std::min({1.0, double(max_width) / m.cols, double(max_height) / m.rows});
         cv::Mat small;
-        if (s < 1) cv::resize(m, small, cv::Size(std::max(1, int(m.cols * s + 0.5)), std::max(1, int(m.rows * s + 0.5))), 0, 0, cv::INTER_AREA);
-        else small = m;
+        if (s < 1)
+            cv::resize(m, small, cv::Size(std::max(1, int(m.cols * s + 0.5)), std::max(1, int(m.rows * s + 0.5))), 0, 0,
+                       cv::INTER_AREA);
+        else
+            small = m;
         small *= std::pow(2.0, ev);
         Fnv1a64 h;
         h.update("thumb");

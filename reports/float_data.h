@@ -27,10 +27,10 @@
 namespace iblcheck::report {
 
 struct FloatImageInfo {
-    std::string key;              // data/<key>.js
+    std::string key; // data/<key>.js
     int width = 0, height = 0, channels = 0;
-    double auto_exposure = 0;     // EV that brings the image's bright end into range (auto_exposure())
-    double max = 0, p99 = 0;      // of the values (error maps: the colour scale)
+    double auto_exposure = 0; // EV that brings the image's bright end into range (auto_exposure())
+    double max = 0, p99 = 0;  // of the values (error maps: the colour scale)
 };
 
 // Exposure in stops such that the 99th percentile of luminance (Rec. 709) among the pixels that
@@ -67,7 +67,7 @@ class DataStore {
     // image's automatic exposure, through the display transform (thumbs/<key>.png); nullopt when the
     // EXR is missing. The PNG the harness wrote has exposure 0, white wherever the sun lights it.
     std::optional<std::string> thumbnail(const std::string& exr_rel, int max_width, int max_height);
-    size_t files() const { return keys_.size(); }  // distinct data scripts this report uses
+    size_t files() const { return keys_.size(); } // distinct data scripts this report uses
 
   private:
     std::string write(const std::string& meta_json, const std::string& packed, uint64_t content_hash);

@@ -30,8 +30,8 @@ std::vector<json> read_history(const std::filesystem::path& file) {
             throw InputError(fmt::format("{}:{}: not a JSON line: {}", file.string(), lineno, e.what()));
         }
         if (!j.is_object() || !j.contains("tests") || !j["tests"].is_object())
-            throw InputError(fmt::format("{}:{}: a history line must be an object with a \"tests\" object",
-                                         file.string(), lineno));
+            throw InputError(
+                fmt::format("{}:{}: a history line must be an object with a \"tests\" object", file.string(), lineno));
         out.push_back(std::move(j));
     }
     return out;

@@ -31,7 +31,8 @@ std::pair<double, std::string> mask_threshold(const json& cmp, const json& t) {
     if (sub(t, "comparisons").is_array())
         for (const json& c : t["comparisons"])
             if (str(c, "kind") == "baseline")
-                if (auto r = from(sub(c, "checks"))) return {r->first, "no per-pixel tolerance against the truth; " + r->second + " against the baseline"};
+                if (auto r = from(sub(c, "checks")))
+                    return {r->first, "no per-pixel tolerance against the truth; " + r->second + " against the baseline"};
     return {0.05, "no per-pixel tolerance: 0.05 shown"};
 }
 
@@ -71,8 +72,9 @@ void comparison_html(std::string& o, const json& t, const json& cmp, size_t k, b
     o += "<div class=\"cols\">";
     if (checks.is_array() && !checks.empty()) {
         const bool stab = noise.is_object() || margins.is_object();
-        fmt::format_to(out, "<table class=\"grid checks\"><tr><th>check</th><th>value</th><th>approved</th><th>min</th>"
-                            "<th>max</th>{}<th>status</th></tr>",
+        fmt::format_to(out,
+                       "<table class=\"grid checks\"><tr><th>check</th><th>value</th><th>approved</th><th>min</th>"
+                       "<th>max</th>{}<th>status</th></tr>",
                        stab ? "<th>noise floor</th><th>margin</th>" : "");
         for (const json& ck : checks) {
             const std::string m = str(ck, "metric"), st = str(ck, "status");
@@ -84,8 +86,8 @@ void comparison_html(std::string& o, const json& t, const json& cmp, size_t k, b
             if (stab) {
                 auto nf = num(noise, m.c_str());
                 auto mg = num(margins, m.c_str());
-                stab_cells = fmt::format("<td class=\"num\">{}</td><td class=\"num\">{}</td>",
-                                         nf ? fmt_num(*nf) : "&ndash;", mg ? fmt_num(*mg) + "&times;" : "&ndash;");
+                stab_cells = fmt::format("<td class=\"num\">{}</td><td class=\"num\">{}</td>", nf ? fmt_num(*nf) : "&ndash;",
+                                         mg ? fmt_num(*mg) + "&times;" : "&ndash;");
             }
             fmt::format_to(out,
                            "<tr><td class=\"mono\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td "
@@ -124,7 +126,8 @@ void cost_html(std::string& o, const json& t) {
     if (auto ipp = num(cost, "spirv_instructions_per_pixel"))
         parts.push_back(fmt::format("SPIR-V instructions/pixel <b>{}</b>{}", fmt_num(*ipp),
                                     approved && *approved != *ipp ? " (approved " + fmt_num(*approved) + ")" : ""));
-    if (auto f = num(t, "texture_fetches_per_pixel")) parts.push_back(fmt::format("texture fetches/pixel <b>{}</b>", fmt_num(*f)));
+    if (auto f = num(t, "texture_fetches_per_pixel"))
+        parts.push_back(fmt::format("texture fetches/pixel <b>{}</b>", fmt_num(*f)));
     if (auto fr = num(t, "frame_ms")) {
         const json& s = sub(t, "frame_ms_samples");
         if (s.is_array() && s.size() > 1 && s.front().is_number() && s.back().is_number())
@@ -164,7 +167,7 @@ void accuracy_html(std::string& o, const json& t) {
                            ? fmt::format(" (the truth's own seed noise: {})", fmt_num(*num(sub(acc, "noise_floor"), "mean_flip")))
                            : "");
     if (ps.is_array() && !ps.empty()) {
-        std::map<double, std::map<int, std::vector<const json*>>> grid;  // roughness -> metal? -> spheres
+        std::map<double, std::map<int, std::vector<const json*>>> grid; // roughness -> metal? -> spheres
         for (const json& sp : ps)
             grid[num(sp, "roughness").value_or(0)][num(sp, "metallic").value_or(0) >= 0.5 ? 1 : 0].push_back(&sp);
         o += "<table class=\"grid spheres\"><tr><th>FLIP per sphere, roughness</th>";
@@ -223,8 +226,8 @@ void temporal_html(std::string& o, const json& tp, ImageStore& store) {
         fmt::format_to(out, "<div class=\"strip\"><span class=\"lbl\">{}<br>frames 1&ndash;{}</span>", label,
                        std::min(u.size(), kStrip));
         for (size_t i = 0; i < u.size() && i < kStrip; ++i)
-            fmt::format_to(out, "<img class=\"frame\" src=\"{}\" alt=\"{} frame {}\" title=\"{} frame {}\">", e(u[i]),
-                           label, i + 1, label, i + 1);
+            fmt::format_to(out, "<img class=\"frame\" src=\"{}\" alt=\"{} frame {}\" title=\"{} frame {}\">", e(u[i]), label,
+                           i + 1, label, i + 1);
         o += "</div>";
     };
     strip("test", ft);
@@ -240,10 +243,14 @@ void temporal_html(std::string& o, const json& tp, ImageStore& store) {
                        "<button type=\"button\">&#9654; play</button><input type=\"range\" min=\"0\" max=\"0\" "
                        "value=\"0\" aria-label=\"frame\"><span class=\"fr meta\"></span></div>",
                        e(join(ft)), e(join(fr)),
-                       ft.empty() ? "" : fmt::format("<figure><img class=\"pt\" src=\"{}\" alt=\"test\"><figcaption>test"
-                                                     "</figcaption></figure>", e(ft[0])),
-                       fr.empty() ? "" : fmt::format("<figure><img class=\"pr\" src=\"{}\" alt=\"reference\">"
-                                                     "<figcaption>reference</figcaption></figure>", e(fr[0])));
+                       ft.empty() ? ""
+                                  : fmt::format("<figure><img class=\"pt\" src=\"{}\" alt=\"test\"><figcaption>test"
+                                                "</figcaption></figure>",
+                                                e(ft[0])),
+                       fr.empty() ? ""
+                                  : fmt::format("<figure><img class=\"pr\" src=\"{}\" alt=\"reference\">"
+                                                "<figcaption>reference</figcaption></figure>",
+                                                e(fr[0])));
     }
     o += "</div>";
 }
@@ -287,15 +294,15 @@ void card_meta(std::string& o, const json& t) {
 void card_why(std::string& o, const json& t, const std::string& v) {
     auto out = std::back_inserter(o);
     if (!str(t, "driver_mismatch").empty())
-        fmt::format_to(out, "<div class=\"warn\">&#9888; {} &mdash; differences may come from the platform (driver or "
-                            "the CPU llvmpipe generates code for), not the shader.</div>\n",
+        fmt::format_to(out,
+                       "<div class=\"warn\">&#9888; {} &mdash; differences may come from the platform (driver or "
+                       "the CPU llvmpipe generates code for), not the shader.</div>\n",
                        e(str(t, "driver_mismatch")));
     // What failed, where, by how much, and the accuracy against the truth before -> after: the
     // lines `iblcheck run` prints (verdict_text.h).
     std::vector<std::string> why = verdict_details(t);
     // Its last line, the bless command, is shown below as a command to copy.
-    if (!why.empty() && (why.back().rfind("approve: ", 0) == 0 || why.back().rfind("lock it in: ", 0) == 0))
-        why.pop_back();
+    if (!why.empty() && (why.back().rfind("approve: ", 0) == 0 || why.back().rfind("lock it in: ", 0) == 0)) why.pop_back();
     if (!why.empty()) {
         o += "<ul class=\"why\">";
         for (const std::string& line : why)
@@ -362,11 +369,15 @@ void card_images(std::string& o, const json& t, const std::string& name, const s
 void card_trend(std::string& o, const Trend& trend) {
     if (!trend.any) return;
     std::string moved;
-    if (!trend.flip.moved.empty()) moved += " &middot; <span class=\"moved-txt\">accuracy moved " + e(trend.flip.moved) + "</span>";
+    if (!trend.flip.moved.empty())
+        moved += " &middot; <span class=\"moved-txt\">accuracy moved " + e(trend.flip.moved) + "</span>";
     if (!trend.cost.moved.empty()) moved += " &middot; <span class=\"moved-txt\">cost moved " + e(trend.cost.moved) + "</span>";
-    if (!trend.frame.moved.empty()) moved += " &middot; <span class=\"moved-txt\">frame time moved " + e(trend.frame.moved) + "</span>";
-    fmt::format_to(std::back_inserter(o), "<div class=\"trend\">History: <span class=\"vstrip\">{}</span>{} &middot; <a href=\"#history\">trend</a></div>",
-                   trend.verdict_strip, moved);
+    if (!trend.frame.moved.empty())
+        moved += " &middot; <span class=\"moved-txt\">frame time moved " + e(trend.frame.moved) + "</span>";
+    fmt::format_to(
+        std::back_inserter(o),
+        "<div class=\"trend\">History: <span class=\"vstrip\">{}</span>{} &middot; <a href=\"#history\">trend</a></div>",
+        trend.verdict_strip, moved);
 }
 
 } // namespace
@@ -377,7 +388,8 @@ void test_card(std::string& o, const json& t, size_t idx, PageContext& ctx, cons
     fmt::format_to(out, "<section class=\"test s-{0} {3}\" id=\"{1}\" data-name=\"{2}\" data-verdict=\"{0}\"{4}>\n", e(v),
                    test_id(idx), e(name), expanded ? "filterable" : "folded", expanded ? "" : " hidden");
     const bool flaky = sub(t, "stability").is_object() && sub(t, "stability").value("flaky", false);
-    fmt::format_to(out, "<div class=\"thead\"><span class=\"badge v-{0}\">{0}</span> <h3><a href=\"#{1}\">{2}</a></h3>{3}{4}</div>\n",
+    fmt::format_to(out,
+                   "<div class=\"thead\"><span class=\"badge v-{0}\">{0}</span> <h3><a href=\"#{1}\">{2}</a></h3>{3}{4}</div>\n",
                    e(v), test_id(idx), e(name), flaky ? " <span class=\"badge flaky\">flaky</span>" : "",
                    expanded ? "" : "<button type=\"button\" class=\"fold\" title=\"fold this card\">fold &#9650;</button>");
     card_meta(o, t);
@@ -402,8 +414,10 @@ void test_tile(std::string& o, const json& t, size_t idx, PageContext& ctx) {
     if (auto th = ctx.data.thumbnail(exr, 280, 64))
         thumb = fmt::format("<img class=\"thumb\" src=\"{}\" alt=\"\" title=\"automatic exposure\">", e(*th));
     else if (!rel.empty()) {
-        if (auto u = ctx.images.url(rel)) thumb = fmt::format("<img class=\"thumb\" src=\"{}\" alt=\"\">", e(*u));
-        else thumb = fmt::format("<div class=\"noimg\">missing image: {}</div>", e(rel));
+        if (auto u = ctx.images.url(rel))
+            thumb = fmt::format("<img class=\"thumb\" src=\"{}\" alt=\"\">", e(*u));
+        else
+            thumb = fmt::format("<div class=\"noimg\">missing image: {}</div>", e(rel));
     }
     std::vector<std::string> nums;
     if (auto a = num(sub(t, "accuracy"), "flip_mean")) nums.push_back("truth " + fmt_num(*a));

@@ -21,8 +21,10 @@ namespace {
 std::string slug(const std::string& g) {
     std::string o;
     for (char ch : g) {
-        if (std::isalnum(static_cast<unsigned char>(ch))) o += ch;
-        else if (o.empty() || o.back() != '-') o += '-';
+        if (std::isalnum(static_cast<unsigned char>(ch)))
+            o += ch;
+        else if (o.empty() || o.back() != '-')
+            o += '-';
     }
     return o;
 }
@@ -92,8 +94,8 @@ std::string cost_panel(const std::string& id, const std::string& title, const st
         p.x = *x;
         p.y = *f;
         p.label = point_label(t);
-        p.tooltip = fmt::format("{}\n{} SPIR-V instructions/pixel, mean FLIP vs the truth {}", str(t, "name"), fmt_num(*x),
-                                fmt_num(*f));
+        p.tooltip =
+            fmt::format("{}\n{} SPIR-V instructions/pixel, mean FLIP vs the truth {}", str(t, "name"), fmt_num(*x), fmt_num(*f));
         p.href = "#" + test_id(page[k]);
         c.series[series[key]].points.push_back(std::move(p));
         xs.push_back(*x);
@@ -192,7 +194,8 @@ std::string wall_panel(const std::string& id, const std::string& title, const st
             spread = fmt::format("median of {}, range {}\u2013{} ms", smp.size(), fmt_num(*p.xlo), fmt_num(*p.xhi));
         }
         p.label = point_label(t);
-        p.tooltip = fmt::format("{}\nframe {} ms ({}), mean FLIP vs the truth {}", str(t, "name"), fmt_num(*x), spread, fmt_num(*f));
+        p.tooltip =
+            fmt::format("{}\nframe {} ms ({}), mean FLIP vs the truth {}", str(t, "name"), fmt_num(*x), spread, fmt_num(*f));
         p.href = "#" + test_id(page[k]);
         c.series[series[key]].points.push_back(std::move(p));
         ++n;
@@ -218,15 +221,15 @@ std::string roughness_panel(const std::string& id, const std::string& title, con
         const std::string col = pal[k % std::size(pal)];
         const std::string base = point_label(t);
         ChartSeries metal = make_series(base, col, false, true);
-        ChartSeries diel = make_series("", col, true, true);  // one legend entry per variant
+        ChartSeries diel = make_series("", col, true, true); // one legend entry per variant
         diel.hollow = true;
         for (const json& s : ps) {
             const double m = num(s, "metallic").value_or(0);
             ChartPoint p;
             p.x = num(s, "roughness").value_or(0);
             p.y = num(s, "flip_mean").value_or(0);
-            p.tooltip = fmt::format("{}\n{}: roughness {}, metallic {}, FLIP {}", str(t, "name"), str(s, "label"),
-                                    fmt_num(p.x), fmt_num(m), fmt_num(p.y));
+            p.tooltip = fmt::format("{}\n{}: roughness {}, metallic {}, FLIP {}", str(t, "name"), str(s, "label"), fmt_num(p.x),
+                                    fmt_num(m), fmt_num(p.y));
             p.href = "#" + test_id(page[k]);
             (m >= 0.5 ? metal : diel).points.push_back(std::move(p));
         }
@@ -277,7 +280,8 @@ void cost_sections(std::string& o, const std::vector<const json*>& tests) {
         cost += cost_panel("cost-accuracy-" + slug(g), g, gt, page, markers);
         // The mobile variants alone: their costs differ by a few percent, invisible beside the others.
         size_t mobile = 0, others = 0;
-        for (const json* t : gt) (str(*t, "method") == "mobile" ? mobile : others) += num(sub(*t, "cost"), "spirv_instructions_per_pixel") ? 1 : 0;
+        for (const json* t : gt)
+            (str(*t, "method") == "mobile" ? mobile : others) += num(sub(*t, "cost"), "spirv_instructions_per_pixel") ? 1 : 0;
         if (mobile >= 3 && others > 0)
             cost += cost_panel("cost-accuracy-mobile-" + slug(g), g + " \u00b7 mobile variants", gt, page, markers, "mobile");
         wall += wall_panel("wall-accuracy-" + slug(g), g, gt, page, markers);
@@ -312,15 +316,17 @@ void roughness_section(std::string& o, const std::vector<const json*>& tests) {
     // Error against roughness: per environment, one panel per variant family against the default.
     o += "<h2 id=\"roughness\">Error against roughness</h2>\n<p class=\"meta\">Per sphere, one row per scene and "
          "environment, one panel per thing a variant changes, each against the method's default (grey).</p>\n";
-    std::map<std::string, std::map<std::string, std::vector<size_t>>> by_env;  // group -> family -> tests
-    std::map<std::string, std::map<std::string, size_t>> defaults;             // group -> method -> default test
+    std::map<std::string, std::map<std::string, std::vector<size_t>>> by_env; // group -> family -> tests
+    std::map<std::string, std::map<std::string, size_t>> defaults;            // group -> method -> default test
     for (size_t i = 0; i < tests.size(); ++i) {
         const json& t = *tests[i];
         if (!sub(t, "per_sphere").is_array() || sub(t, "per_sphere").empty()) continue;
         const std::string fam = variant_family(t), g = group_of(t);
-        if (fam == "default") defaults[g][str(t, "method")] = i;
-        else by_env[g][str(t, "method") == "mobile" ? fam : str(t, "method") + " " + fam].push_back(i);
-        if (fam == "default" && !by_env[g].count("")) by_env[g];  // the group exists even with defaults only
+        if (fam == "default")
+            defaults[g][str(t, "method")] = i;
+        else
+            by_env[g][str(t, "method") == "mobile" ? fam : str(t, "method") + " " + fam].push_back(i);
+        if (fam == "default" && !by_env[g].count("")) by_env[g]; // the group exists even with defaults only
     }
     bool any = false;
     for (auto& [g, fams] : by_env) {
@@ -392,12 +398,13 @@ void flicker_section(std::string& o, const std::vector<const json*>& tests) {
         ChartPoint p;
         p.x = *fm;
         p.y = *fl;
-        p.label = test_label(t) + " \u00b7 " + str(t, "env");  // method, variant and environment
+        p.label = test_label(t) + " \u00b7 " + str(t, "env"); // method, variant and environment
         p.tooltip = fmt::format("{}\nFLIP = {}, flicker = {}", str(t, "name"), fmt_num(*fm), fmt_num(*fl));
         p.href = "#" + test_id(i);
         it->points.push_back(std::move(p));
     }
-    if (flick.empty()) o += "<p class=\"meta\">No temporal test in this run.</p>\n";
+    if (flick.empty())
+        o += "<p class=\"meta\">No temporal test in this run.</p>\n";
     else {
         o += "<div class=\"charts\">";
         for (auto& [g, c] : flick) o += render_chart(c);

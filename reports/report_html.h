@@ -69,13 +69,13 @@ struct PageContext {
 
 // What the image viewer shows: a test image against a golden, with the FLIP heatmap.
 struct ViewerSpec {
-    std::string test_png, golden_png, heat_png;  // as in results.json
+    std::string test_png, golden_png, heat_png; // as in results.json
     std::string test_exr, golden_exr, error_exr;
-    std::string golden_name = "golden";          // "baseline", "reference"
+    std::string golden_name = "golden"; // "baseline", "reference"
     std::optional<int> block_x, block_y;
     std::string block_sphere;
     double tol = 0.05;
-    std::string tol_note;                        // where the threshold comes from
+    std::string tol_note; // where the threshold comes from
 };
 // The image viewer (report_viewer.cpp): the PNGs, and canvases over the float data for the script.
 void viewer_html(std::string& o, PageContext& ctx, const json& t, const ViewerSpec& vs);

@@ -13,8 +13,7 @@ namespace {
 
 std::string img_tag(ImageStore& store, const std::string& rel, const char* cls, const std::string& alt) {
     if (rel.empty()) return "";
-    if (auto u = store.url(rel))
-        return fmt::format("<img class=\"{}\" src=\"{}\" alt=\"{}\">", cls, e(*u), e(alt));
+    if (auto u = store.url(rel)) return fmt::format("<img class=\"{}\" src=\"{}\" alt=\"{}\">", cls, e(*u), e(alt));
     return fmt::format("<div class=\"noimg\">missing image:<br><span class=\"mono\">{}</span></div>", e(rel));
 }
 
@@ -61,7 +60,8 @@ void viewer_html(std::string& o, PageContext& ctx, const json& t, const ViewerSp
                            "class=\"blink\"> blink</label></span>",
                            e(vs.golden_name));
         o += "<span class=\"zooms\">zoom";
-        for (int z : {1, 2, 3, 4, 6, 8}) fmt::format_to(out, "<button type=\"button\" class=\"z\" data-z=\"{0}\">{0}&times;</button>", z);
+        for (int z : {1, 2, 3, 4, 6, 8})
+            fmt::format_to(out, "<button type=\"button\" class=\"z\" data-z=\"{0}\">{0}&times;</button>", z);
         o += "</span>";
         if (has_heat)
             fmt::format_to(out,
@@ -93,8 +93,9 @@ void viewer_html(std::string& o, PageContext& ctx, const json& t, const ViewerSp
     auto blk = [&] {
         return vs.block_x ? std::string("<span class=\"blk\" title=\"worst 16x16 block\"></span>") : std::string();
     };
-    fmt::format_to(out, "<figure class=\"vimg\"><div class=\"stage\">{}{}<canvas class=\"cv-img\" hidden></canvas>{}"
-                        "<span class=\"ptr\" hidden></span></div><figcaption>{}</figcaption></figure>",
+    fmt::format_to(out,
+                   "<figure class=\"vimg\"><div class=\"stage\">{}{}<canvas class=\"cv-img\" hidden></canvas>{}"
+                   "<span class=\"ptr\" hidden></span></div><figcaption>{}</figcaption></figure>",
                    img_tag(ctx.images, vs.test_png, "png t", "test"),
                    has_golden ? img_tag(ctx.images, vs.golden_png, "png g", vs.golden_name) : "", blk(),
                    has_golden ? "test (buttons: " + e(vs.golden_name) + "); pointer: sphere and values; click: pin the magnifier"
@@ -109,19 +110,21 @@ void viewer_html(std::string& o, PageContext& ctx, const json& t, const ViewerSp
                  "style=\"left:64px\"></span><span class=\"tk\" style=\"left:128px\"></span><span class=\"tk\" "
                  "style=\"left:192px\"></span><span class=\"tk\" style=\"left:256px\"></span><span class=\"tol\" "
                  "title=\"mask threshold\"></span></div>";
-        fmt::format_to(out, "<figcaption>FLIP per pixel vs the {} (magma{}){} <span class=\"maskinfo\"></span></figcaption></figure>", e(vs.golden_name),
-                       live && ei ? ", scale on the bar" : " 0&ndash;1",
+        fmt::format_to(out,
+                       "<figcaption>FLIP per pixel vs the {} (magma{}){} <span class=\"maskinfo\"></span></figcaption></figure>",
+                       e(vs.golden_name), live && ei ? ", scale on the bar" : " 0&ndash;1",
                        vs.block_x ? "; green: the worst 16&times;16 block" : "");
     }
     o += "</div>";
     if (live && vs.block_x)
-        fmt::format_to(out,
-                       "<figure class=\"vmag\"><div class=\"mags\"><div><canvas class=\"mg-t\"></canvas><div class=\"mlbl\">"
-                       "test</div></div>{}{}</div><figcaption class=\"mcap\">worst 16&times;16 block ({},{}){}</figcaption>"
-                       "<button type=\"button\" class=\"worst\">back to the worst block</button></figure>",
-                       has_golden ? "<div><canvas class=\"mg-g\"></canvas><div class=\"mlbl\">" + e(vs.golden_name) + "</div></div>" : "",
-                       has_heat ? "<div><canvas class=\"mg-e\"></canvas><div class=\"mlbl\">FLIP</div></div>" : "", *vs.block_x,
-                       *vs.block_y, vs.block_sphere.empty() ? "" : " on " + e(vs.block_sphere));
+        fmt::format_to(
+            out,
+            "<figure class=\"vmag\"><div class=\"mags\"><div><canvas class=\"mg-t\"></canvas><div class=\"mlbl\">"
+            "test</div></div>{}{}</div><figcaption class=\"mcap\">worst 16&times;16 block ({},{}){}</figcaption>"
+            "<button type=\"button\" class=\"worst\">back to the worst block</button></figure>",
+            has_golden ? "<div><canvas class=\"mg-g\"></canvas><div class=\"mlbl\">" + e(vs.golden_name) + "</div></div>" : "",
+            has_heat ? "<div><canvas class=\"mg-e\"></canvas><div class=\"mlbl\">FLIP</div></div>" : "", *vs.block_x, *vs.block_y,
+            vs.block_sphere.empty() ? "" : " on " + e(vs.block_sphere));
     o += "</div>";
     if (live) o += "<div class=\"readout mono\">point at an image: pixel, sphere, linear values</div>";
     o += "</div>\n";

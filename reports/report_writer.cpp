@@ -58,8 +58,10 @@ Trend trend_for(const History& h, const std::string& test) {
         auto med = num(x, "frame_ms");
         auto lo = num(x, "frame_ms_lo"), hi = num(x, "frame_ms_hi");
         frame.push_back({c, d, med, lo, hi});
-        if (med) spreads.push_back(Spread{lo.value_or(*med), *med, hi.value_or(*med)});
-        else spreads.push_back(std::nullopt);
+        if (med)
+            spreads.push_back(Spread{lo.value_or(*med), *med, hi.value_or(*med)});
+        else
+            spreads.push_back(std::nullopt);
     }
     t.flip = render_sparkline("history-flip_mean", test, flip, "", accuracy_flag(flips, commits, floor));
     // The instruction count is deterministic: any change is a change (half a percent: not rounding).
@@ -129,8 +131,8 @@ std::string since_baselines_html(const json& results, const std::vector<const js
         for (size_t i = 0; i < v.size() && i < 3; ++i) {
             std::string k = v[i].second.substr(0, cut);
             if (dates && dates->count(v[i].second)) k += ", " + dates->at(v[i].second).substr(0, 10);
-            s += (s.empty() ? "" : "; ") + fmt::format("<span class=\"mono\">{}</span> ({} test{})", e(k), v[i].first,
-                                                       v[i].first == 1 ? "" : "s");
+            s += (s.empty() ? "" : "; ") +
+                 fmt::format("<span class=\"mono\">{}</span> ({} test{})", e(k), v[i].first, v[i].first == 1 ? "" : "s");
         }
         if (v.size() > 3) s += fmt::format("; {} more", v.size() - 3);
         return s;
@@ -150,12 +152,14 @@ std::string since_baselines_html(const json& results, const std::vector<const js
         int changed = 0;
         for (auto& [k, n] : commit_then) {
             std::string bare = k.size() > 6 && k.substr(k.size() - 6) == "-dirty" ? k.substr(0, k.size() - 6) : k;
-            if (bare.substr(0, std::min(bare.size(), size_t(7))) != str(results, "commit").substr(0, std::min(size_t(7), str(results, "commit").size())))
+            if (bare.substr(0, std::min(bare.size(), size_t(7))) !=
+                str(results, "commit").substr(0, std::min(size_t(7), str(results, "commit").size())))
                 changed += n;
         }
         o += fmt::format("<tr><th>commit</th><td>{}</td><td class=\"mono\">{}</td>{}</tr>", list(commit_then, 12, &commit_date),
-                         e(now), changed ? fmt::format("<td>{} of {} blessed at another commit</td>", changed, judged)
-                                         : std::string("<td class=\"same\">same</td>"));
+                         e(now),
+                         changed ? fmt::format("<td>{} of {} blessed at another commit</td>", changed, judged)
+                                 : std::string("<td class=\"same\">same</td>"));
     }
     if (!driver_then.empty())
         o += fmt::format("<tr><th>driver</th><td>{}</td><td>{}</td>{}</tr>", list(driver_then, 60), e(driver_now),
@@ -186,9 +190,9 @@ std::string js_config() {
     const float* k = flip::kToneCoefficients[int(flip::ToneMapper::aces)];
     std::string magma;
     for (int i = 0; i < 256; ++i)
-        for (int c = 0; c < 3; ++c) magma += fmt::format("{}{}", magma.empty() ? "" : ",", int(flip::kMagma[i][c] * 255.0f + 0.5f));
-    return fmt::format("window.IBLCHECK_CFG={{aces:[{},{},{},{},{},{}],magma:[{}]}};", k[0], k[1], k[2], k[3], k[4], k[5],
-                       magma);
+        for (int c = 0; c < 3; ++c)
+            magma += fmt::format("{}{}", magma.empty() ? "" : ",", int(flip::kMagma[i][c] * 255.0f + 0.5f));
+    return fmt::format("window.IBLCHECK_CFG={{aces:[{},{},{},{},{},{}],magma:[{}]}};", k[0], k[1], k[2], k[3], k[4], k[5], magma);
 }
 
 // ---- the page, section by section; each appends its HTML to `o` ----
@@ -218,8 +222,7 @@ History history_window(const std::vector<json>& history, const json& current) {
     for (const json& h : history)
         if (str(h, "suite").empty() || str(current, "suite").empty() || str(h, "suite") == str(current, "suite"))
             all.push_back(&h);
-    if (all.empty() || str(*all.back(), "commit") != str(current, "commit") ||
-        str(*all.back(), "date") != str(current, "date"))
+    if (all.empty() || str(*all.back(), "commit") != str(current, "commit") || str(*all.back(), "date") != str(current, "date"))
         all.push_back(&current);
     const size_t first = all.size() > History::kMaxRuns ? all.size() - History::kMaxRuns : 0;
     hist.runs.assign(all.begin() + long(first), all.end());
@@ -252,9 +255,11 @@ void summary_facts(std::string& o, const json& results, size_t n_tests) {
     if (!value_text(sub(drv, "device")).empty()) facts.push_back("device <b>" + e(value_text(sub(drv, "device"))) + "</b>");
     std::string v;
     for (auto [k, label] : {std::pair{"mesa", "Mesa"}, {"llvm", "LLVM"}, {"api", "Vulkan"}})
-        if (!value_text(sub(drv, k)).empty()) v += (v.empty() ? "" : " &middot; ") + fmt::format("{} <b>{}</b>", label, e(value_text(sub(drv, k))));
+        if (!value_text(sub(drv, k)).empty())
+            v += (v.empty() ? "" : " &middot; ") + fmt::format("{} <b>{}</b>", label, e(value_text(sub(drv, k))));
     if (!v.empty()) facts.push_back(v);
-    if (!str(results, "cpu_class").empty()) facts.push_back("CPU class <b class=\"mono\">" + e(str(results, "cpu_class")) + "</b>");
+    if (!str(results, "cpu_class").empty())
+        facts.push_back("CPU class <b class=\"mono\">" + e(str(results, "cpu_class")) + "</b>");
     std::string fj;
     for (auto& f : facts) fj += (fj.empty() ? "" : " &middot; ") + f;
     fmt::format_to(std::back_inserter(o), "<div class=\"facts\">{}</div>\n", fj);
@@ -266,8 +271,9 @@ void summary_section(std::string& o, const json& results, const std::vector<cons
                      std::map<std::string, int>& counts, bool bad) {
     auto out = std::back_inserter(o);
     const std::string suite = str(results, "suite");
-    fmt::format_to(out, "<header class=\"summary{}\"><div class=\"hrow\"><h1>iblcheck &middot; suite {} <span class=\"badge "
-                        "v-{}\">{}</span></h1><div class=\"counts\">",
+    fmt::format_to(out,
+                   "<header class=\"summary{}\"><div class=\"hrow\"><h1>iblcheck &middot; suite {} <span class=\"badge "
+                   "v-{}\">{}</span></h1><div class=\"counts\">",
                    bad ? " overall-fail" : "", e(suite.empty() ? "?" : suite), bad ? "fail" : "pass", bad ? "failed" : "passed");
     for (auto& v : verdict_order())
         fmt::format_to(out,
@@ -278,8 +284,9 @@ void summary_section(std::string& o, const json& results, const std::vector<cons
     summary_facts(o, results, tests.size());
     o += since_baselines_html(results, tests);
     if (!str(results, "command").empty())
-        fmt::format_to(out, "<div class=\"cmd\"><span class=\"lbl\">run</span><pre><code>{}</code></pre><button "
-                            "type=\"button\" class=\"copy\">Copy</button></div>\n",
+        fmt::format_to(out,
+                       "<div class=\"cmd\"><span class=\"lbl\">run</span><pre><code>{}</code></pre><button "
+                       "type=\"button\" class=\"copy\">Copy</button></div>\n",
                        e(str(results, "command")));
     json arr = json::array();
     for (const json* t : tests) arr.push_back(*t);
@@ -303,8 +310,10 @@ void tabs_nav(std::string& o, size_t n_tests) {
                    "by name\"><span class=\"vfilter\">",
                    n_tests);
     for (auto& v : verdict_order())
-        fmt::format_to(out, "<label title=\"{0}\"><input type=\"checkbox\" value=\"{0}\" checked><span class=\"badge v-{0}\">{1}</span></label>",
-                       v, v == "missing-golden" ? "missing" : v);
+        fmt::format_to(
+            out,
+            "<label title=\"{0}\"><input type=\"checkbox\" value=\"{0}\" checked><span class=\"badge v-{0}\">{1}</span></label>",
+            v, v == "missing-golden" ? "missing" : v);
     o += "</span><span id=\"filter-count\" class=\"meta\"></span></span></nav>\n";
 }
 
@@ -324,7 +333,8 @@ void failure_modes(std::string& o, const std::vector<const json*>& tests) {
             const json& t = *tests[idx[k]];
             auto acc = num(sub(t, "accuracy"), "flip_mean");
             fmt::format_to(std::back_inserter(o),
-                           "<tr>{}<td><a href=\"#{}\">{}</a></td><td class=\"num\">{}</td><td><span class=\"badge v-{}\">{}</span></td></tr>\n",
+                           "<tr>{}<td><a href=\"#{}\">{}</a></td><td class=\"num\">{}</td><td><span class=\"badge "
+                           "v-{}\">{}</span></td></tr>\n",
                            k == 0 ? fmt::format("<td rowspan=\"{}\"><b>{}</b></td>", idx.size(), e(mode)) : std::string(),
                            test_id(idx[k]), e(str(t, "name")), acc ? fmt_num(*acc) : std::string(), e(str(t, "verdict")),
                            e(str(t, "verdict")));
@@ -357,8 +367,7 @@ void tests_tab(std::string& o, const std::vector<const json*>& tests, PageContex
     o += "</section>\n";
 }
 
-void history_tab(std::string& o, const std::vector<const json*>& tests, const History& hist,
-                 const std::vector<Trend>& trends) {
+void history_tab(std::string& o, const std::vector<const json*>& tests, const History& hist, const std::vector<Trend>& trends) {
     auto out = std::back_inserter(o);
     o += "<section class=\"tab\" id=\"tab-history\">\n<h2>History</h2>\n";
     if (hist.runs.size() < 2) {
@@ -410,8 +419,7 @@ void table_tab(std::string& o, const std::vector<const json*>& tests) {
                        "{0}</span></td><td><a href=\"#{1}\">{2}</a></td><td class=\"num\">{3}</td><td class=\"num\">{4}"
                        "</td><td class=\"num\">{5}</td><td class=\"num\">{6}</td><td class=\"num\">{7}</td><td "
                        "title=\"{9}\">{8}</td></tr>\n",
-                       e(v), test_id(i), e(str(t, "name")), cellnum(golden_flip),
-                       cellnum(num(sub(t, "accuracy"), "flip_mean")),
+                       e(v), test_id(i), e(str(t, "name")), cellnum(golden_flip), cellnum(num(sub(t, "accuracy"), "flip_mean")),
                        cellnum(num(sub(t, "cost"), "spirv_instructions_per_pixel")), cellnum(num(t, "frame_ms")),
                        cellnum(num(t, "precompute_ms")), e(short_message(str(t, "message"))), e(str(t, "message")));
     }
@@ -450,8 +458,7 @@ void write_atomically(const fs::path& out_dir, const std::string& o) {
 
 } // namespace
 
-void write_report(const json& results, const fs::path& results_dir, const fs::path& out_dir,
-                  const std::vector<json>& history) {
+void write_report(const json& results, const fs::path& results_dir, const fs::path& out_dir, const std::vector<json>& history) {
     validate_results(results, (results_dir / "results.json").string());
     std::error_code ec;
     fs::create_directories(out_dir, ec);

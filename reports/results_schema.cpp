@@ -33,9 +33,7 @@ struct Checker : JsonChecker {
     void number(const json& obj, const std::string& where, const char* key, bool required = false) const {
         member(obj, where, key, JsonType::number, required);
     }
-    void boolean(const json& obj, const std::string& where, const char* key) const {
-        member(obj, where, key, JsonType::boolean);
-    }
+    void boolean(const json& obj, const std::string& where, const char* key) const { member(obj, where, key, JsonType::boolean); }
     // Return nullptr when absent or null.
     const json* object(const json& obj, const std::string& where, const char* key) const {
         return member(obj, where, key, JsonType::object);
@@ -47,8 +45,7 @@ struct Checker : JsonChecker {
         if (const json* a = array(obj, where, key))
             for (size_t i = 0; i < a->size(); ++i)
                 if (!(*a)[i].is_string())
-                    fail(where, fmt::format("'{}[{}]' must be a string (an image path), not {}", key, i,
-                                            (*a)[i].type_name()));
+                    fail(where, fmt::format("'{}[{}]' must be a string (an image path), not {}", key, i, (*a)[i].type_name()));
     }
     void number_map(const json& obj, const std::string& where, const char* key) const {
         if (const json* m = object(obj, where, key))
@@ -94,8 +91,7 @@ void check_comparison(const Checker& c, const json& cmp, const std::string& cw) 
     }
     if (const json* ap = c.object(cmp, cw, "approved"))
         for (auto& [k, v] : ap->items())
-            if (!v.is_string() && !v.is_null())
-                c.fail(cw, fmt::format("approved.{} must be a string, not {}", k, v.type_name()));
+            if (!v.is_string() && !v.is_null()) c.fail(cw, fmt::format("approved.{} must be a string, not {}", k, v.type_name()));
     if (const json* imgs = c.object(cmp, cw, "images"))
         for (auto& [k, v] : imgs->items())
             if (!v.is_string() && !v.is_null())
@@ -151,10 +147,11 @@ void check_test(const Checker& c, const json& t, size_t i) {
     const std::string verdict = t["verdict"].get<std::string>();
     if (!verdicts().count(verdict))
         c.fail(where, fmt::format("verdict '{}' is not one of pass, fail, improved, missing-golden, error", verdict));
-    for (const char* k : {"suite", "scene", "method", "env", "variant", "message", "bless_command", "driver_mismatch", "image",
-                          "image_exr"})
+    for (const char* k :
+         {"suite", "scene", "method", "env", "variant", "message", "bless_command", "driver_mismatch", "image", "image_exr"})
         c.string_(t, where, k);
-    for (const char* k : {"width", "height", "precompute_ms", "frame_ms", "texture_fetches_per_pixel", "texture_bytes", "texel_count"})
+    for (const char* k :
+         {"width", "height", "precompute_ms", "frame_ms", "texture_fetches_per_pixel", "texture_bytes", "texel_count"})
         c.number(t, where, k);
     c.number_map(t, where, "cost");
     if (const json* smp = c.array(t, where, "frame_ms_samples"))

@@ -26,8 +26,8 @@ std::vector<size_t> pareto_front(const std::vector<std::pair<double, double>>& p
         bool dominated = false;
         for (size_t j = 0; j < p.size() && !dominated; ++j) {
             if (j == i) continue;
-            dominated = p[j].first <= p[i].first && p[j].second <= p[i].second &&
-                        (p[j].first < p[i].first || p[j].second < p[i].second);
+            dominated =
+                p[j].first <= p[i].first && p[j].second <= p[i].second && (p[j].first < p[i].first || p[j].second < p[i].second);
         }
         if (!dominated) front.push_back(i);
     }
@@ -36,12 +36,12 @@ std::vector<size_t> pareto_front(const std::vector<std::pair<double, double>>& p
 
 const std::vector<std::string>& marker_shapes() {
     static const std::vector<std::string> shapes{"circle", "square", "triangle", "diamond", "triangle-down",
-                                                 "cross", "plus", "star", "hexagon"};
+                                                 "cross",  "plus",   "star",     "hexagon"};
     return shapes;
 }
 
-std::string marker_svg(const std::string& shape, double x, double y, double r, const std::string& fill,
-                       const std::string& cls, bool hollow) {
+std::string marker_svg(const std::string& shape, double x, double y, double r, const std::string& fill, const std::string& cls,
+                       bool hollow) {
     const std::string c = "point" + std::string(hollow ? " hollow" : "") + (cls.empty() ? "" : " " + cls);
     // A hollow marker is an outline in the colour (inline style: it must win over the charts' CSS).
     const std::string paint = hollow ? fmt::format("fill=\"#fff\" stroke=\"{0}\" style=\"stroke:{0}\"", html_escape(fill))
@@ -57,11 +57,31 @@ std::string marker_svg(const std::string& shape, double x, double y, double r, c
     if (shape == "triangle-down") return poly({{0, 1.15}, {1.05, -0.75}, {-1.05, -0.75}});
     if (shape == "diamond") return poly({{0, -1.2}, {1.0, 0}, {0, 1.2}, {-1.0, 0}});
     if (shape == "cross")
-        return poly({{-1, -0.6}, {-0.6, -1}, {0, -0.4}, {0.6, -1}, {1, -0.6}, {0.4, 0}, {1, 0.6}, {0.6, 1}, {0, 0.4},
-                     {-0.6, 1}, {-1, 0.6}, {-0.4, 0}});
+        return poly({{-1, -0.6},
+                     {-0.6, -1},
+                     {0, -0.4},
+                     {0.6, -1},
+                     {1, -0.6},
+                     {0.4, 0},
+                     {1, 0.6},
+                     {0.6, 1},
+                     {0, 0.4},
+                     {-0.6, 1},
+                     {-1, 0.6},
+                     {-0.4, 0}});
     if (shape == "plus")
-        return poly({{-0.3, -1}, {0.3, -1}, {0.3, -0.3}, {1, -0.3}, {1, 0.3}, {0.3, 0.3}, {0.3, 1}, {-0.3, 1},
-                     {-0.3, 0.3}, {-1, 0.3}, {-1, -0.3}, {-0.3, -0.3}});
+        return poly({{-0.3, -1},
+                     {0.3, -1},
+                     {0.3, -0.3},
+                     {1, -0.3},
+                     {1, 0.3},
+                     {0.3, 0.3},
+                     {0.3, 1},
+                     {-0.3, 1},
+                     {-0.3, 0.3},
+                     {-1, 0.3},
+                     {-1, -0.3},
+                     {-0.3, -0.3}});
     if (shape == "star") {
         std::vector<std::pair<double, double>> p;
         for (int i = 0; i < 10; ++i) {
@@ -207,8 +227,7 @@ std::vector<LegendItem> layout_legend(const Chart& c, double W, double px0, doub
 void axes_svg(std::string& o, const Chart& c, const Plot& pl, bool empty) {
     auto out = std::back_inserter(o);
     const double px0 = pl.px0, px1 = pl.px1, py0 = pl.py0, py1 = pl.py1;
-    fmt::format_to(out, "<rect class=\"plot\" x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\"/>\n", px0, py0, px1 - px0,
-                   py1 - py0);
+    fmt::format_to(out, "<rect class=\"plot\" x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\"/>\n", px0, py0, px1 - px0, py1 - py0);
     for (double t : pl.sx.ticks) {
         const double x = pl.sx(t);
         fmt::format_to(out,
@@ -225,14 +244,13 @@ void axes_svg(std::string& o, const Chart& c, const Plot& pl, bool empty) {
                        "<text class=\"tl\" x=\"{4}\" y=\"{5:.1f}\" text-anchor=\"end\">{6}</text>\n",
                        y, px0, px1, px0 - 5, px0 - 8, y + 4, fmt_num(t));
     }
-    fmt::format_to(out, "<text class=\"al\" x=\"{}\" y=\"{}\" text-anchor=\"middle\">{}{}</text>\n", (px0 + px1) / 2,
-                   py1 + 36, html_escape(c.x.label), c.x.log ? " (log scale)" : "");
-    fmt::format_to(out,
-                   "<text class=\"al\" transform=\"translate(16 {}) rotate(-90)\" text-anchor=\"middle\">{}{}</text>\n",
+    fmt::format_to(out, "<text class=\"al\" x=\"{}\" y=\"{}\" text-anchor=\"middle\">{}{}</text>\n", (px0 + px1) / 2, py1 + 36,
+                   html_escape(c.x.label), c.x.log ? " (log scale)" : "");
+    fmt::format_to(out, "<text class=\"al\" transform=\"translate(16 {}) rotate(-90)\" text-anchor=\"middle\">{}{}</text>\n",
                    (py0 + py1) / 2, html_escape(c.y.label), c.y.log ? " (log scale)" : "");
     if (empty)
-        fmt::format_to(out, "<text class=\"cnote\" x=\"{}\" y=\"{}\" text-anchor=\"middle\">no data</text>\n",
-                       (px0 + px1) / 2, (py0 + py1) / 2);
+        fmt::format_to(out, "<text class=\"cnote\" x=\"{}\" y=\"{}\" text-anchor=\"middle\">no data</text>\n", (px0 + px1) / 2,
+                       (py0 + py1) / 2);
 }
 
 // Pareto front: staircase through the non-dominated points (everything above/right is worse).
@@ -299,8 +317,7 @@ void points_svg(std::string& o, const Chart& c, const std::vector<PlotPoint>& pt
                                          html_escape(s.name), p.p->x, p.p->y, html_escape(p.p->label),
                                          html_escape(p.p->tooltip.empty() ? p.p->label : p.p->tooltip),
                                          s.marker == "circle" ? "</circle>" : "</path>");
-        if (!p.p->href.empty())
-            circle = fmt::format("<a href=\"{}\">{}</a>", html_escape(p.p->href), circle);
+        if (!p.p->href.empty()) circle = fmt::format("<a href=\"{}\">{}</a>", html_escape(p.p->href), circle);
         o += circle;
         if (!p.p->label.empty()) {
             const double w = 5.6 * double(p.p->label.size()), h = 11;
@@ -311,8 +328,7 @@ void points_svg(std::string& o, const Chart& c, const std::vector<PlotPoint>& pt
                 if (b.y0 < pl.py0 || b.y1 > pl.py1 || b.x0 < pl.px0 - 2) continue;
                 if (std::any_of(placed.begin(), placed.end(), [&](const Box& q) { return q.hits(b); })) continue;
                 placed.push_back(b);
-                fmt::format_to(out, "<text class=\"pl\" x=\"{:.1f}\" y=\"{:.1f}\">{}</text>", lx, ly,
-                               html_escape(p.p->label));
+                fmt::format_to(out, "<text class=\"pl\" x=\"{:.1f}\" y=\"{:.1f}\">{}</text>", lx, ly, html_escape(p.p->label));
                 break;
             }
         }
@@ -332,8 +348,8 @@ void legend_svg(std::string& o, const std::vector<LegendItem>& legend) {
                            "<g class=\"legend\"><line class=\"series{0}\" x1=\"{1:.1f}\" y1=\"{2:.1f}\" x2=\"{3:.1f}\" "
                            "y2=\"{2:.1f}\" stroke=\"{4}\"/><circle cx=\"{5:.1f}\" cy=\"{2:.1f}\" r=\"4\" fill=\"{4}\"/>"
                            "<text x=\"{6:.1f}\" y=\"{7:.1f}\">{8}</text></g>\n",
-                           it.dashed ? " dashed" : "", it.x, it.y, it.x + 26, html_escape(it.color), it.x + 13,
-                           it.x + 32, it.y + 4, html_escape(it.name));
+                           it.dashed ? " dashed" : "", it.x, it.y, it.x + 26, html_escape(it.color), it.x + 13, it.x + 32,
+                           it.y + 4, html_escape(it.name));
     }
 }
 
@@ -431,8 +447,8 @@ Sparkline render_sparkline(const std::string& id, const std::string& test_name, 
                        "<circle class=\"point{}\" cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"{}\" data-commit=\"{}\" data-y=\"{}\">"
                        "<title>{} {}: {}{}{}</title></circle>",
                        k + 1 == idx.size() ? " last" : "", X(idx[k]), Y(*run.value), k + 1 == idx.size() ? 3 : 1.8,
-                       html_escape(run.commit), *run.value, html_escape(run.commit), html_escape(run.date),
-                       fmt_num(*run.value), html_escape(unit), html_escape(range));
+                       html_escape(run.commit), *run.value, html_escape(run.commit), html_escape(run.date), fmt_num(*run.value),
+                       html_escape(unit), html_escape(range));
     }
     o += "</svg>";
     r.svg = std::move(o);

@@ -20,19 +20,19 @@ std::string fmt_num(double v);
 struct ChartPoint {
     double x = 0, y = 0;
     std::optional<double> xlo, xhi; // a horizontal range drawn through the point (repeated timings)
-    std::string label;   // drawn next to the point (may be empty)
-    std::string tooltip; // <title>
-    std::string href;    // optional link (e.g. "#t-3": the test's card)
+    std::string label;              // drawn next to the point (may be empty)
+    std::string tooltip;            // <title>
+    std::string href;               // optional link (e.g. "#t-3": the test's card)
 };
 
 struct ChartSeries {
-    std::string name;  // legend
+    std::string name; // legend
     std::string color;
     bool dashed = false;
     bool connect = false; // draw a line through the points (sorted by x)
     // circle, square, triangle, diamond, triangle-down, cross, plus, star, hexagon (marker_shapes())
     std::string marker = "circle";
-    bool hollow = false;  // marker drawn as an outline
+    bool hollow = false; // marker drawn as an outline
     std::vector<ChartPoint> points;
 };
 
@@ -52,21 +52,21 @@ struct ChartAxis {
 };
 
 struct Chart {
-    std::string id;    // data-chart
+    std::string id; // data-chart
     std::string title;
-    std::string note;  // a line under the title
+    std::string note; // a line under the title
     ChartAxis x, y;
     std::vector<ChartSeries> series;
-    bool pareto = false; // draw the Pareto front over all points (lower-left is better)
+    bool pareto = false;                   // draw the Pareto front over all points (lower-left is better)
     double width = 640, plot_height = 262; // a small multiple is smaller
-    bool legend = true;  // small multiples share one legend outside the panels
+    bool legend = true;                    // small multiples share one legend outside the panels
 };
 
 // The marker shapes a series may use, in the order variants are given them.
 const std::vector<std::string>& marker_shapes();
 // An SVG element (class "point" plus `cls`) drawing `shape` centred on (x, y).
-std::string marker_svg(const std::string& shape, double x, double y, double r, const std::string& fill,
-                       const std::string& cls, bool hollow);
+std::string marker_svg(const std::string& shape, double x, double y, double r, const std::string& fill, const std::string& cls,
+                       bool hollow);
 
 std::string render_chart(const Chart& chart);
 
@@ -77,14 +77,14 @@ std::vector<size_t> pareto_front(const std::vector<std::pair<double, double>>& p
 struct SparkRun {
     std::string commit, date;
     std::optional<double> value;
-    std::optional<double> lo, hi;  // the run's measured range (repeated timings), drawn as a bar
+    std::optional<double> lo, hi; // the run's measured range (repeated timings), drawn as a bar
 };
 
 struct Sparkline {
     std::string svg;
-    std::string moved;      // the flag's text ("+3.1 % at c4 (noise floor 0.0017)"); else ""
+    std::string moved; // the flag's text ("+3.1 % at c4 (noise floor 0.0017)"); else ""
     std::string moved_commit;
-    std::string range;      // "0.03–0.052 ms": the values' span
+    std::string range; // "0.03–0.052 ms": the values' span
     size_t points = 0;
 };
 

@@ -79,10 +79,8 @@ struct Pair {
 };
 
 const Pair& synthetic(bool hdr) {
-    static const Pair ldr{synthetic_pair_image(1920, 1080, 1, false, false),
-                          synthetic_pair_image(1920, 1080, 2, false, true)};
-    static const Pair hdrp{synthetic_pair_image(1920, 1080, 3, true, false),
-                           synthetic_pair_image(1920, 1080, 4, true, true)};
+    static const Pair ldr{synthetic_pair_image(1920, 1080, 1, false, false), synthetic_pair_image(1920, 1080, 2, false, true)};
+    static const Pair hdrp{synthetic_pair_image(1920, 1080, 3, true, false), synthetic_pair_image(1920, 1080, 4, true, true)};
     return hdr ? hdrp : ldr;
 }
 
@@ -129,11 +127,12 @@ void register_flip(const std::string& input, bool hdr, const std::function<const
             if (threads == 2 && k == &flip::scalar_kernels()) continue; // the reference: 1 thread is enough
             const std::string name =
                 fmt::format("flip/{}/{}/{}/threads:{}", input, hdr ? "hdr1080_9exp" : "ldr1080", k->name, threads);
-            benchmark::RegisterBenchmark(name.c_str(), [=](benchmark::State& st) {
-                const Pair* p = pair();
-                if (!p) return st.SkipWithError("input not available");
-                run_flip(st, *p, hdr, *k, threads);
-            })
+            benchmark::RegisterBenchmark(name.c_str(),
+                                         [=](benchmark::State& st) {
+                                             const Pair* p = pair();
+                                             if (!p) return st.SkipWithError("input not available");
+                                             run_flip(st, *p, hdr, *k, threads);
+                                         })
                 ->Unit(benchmark::kMillisecond)
                 ->UseRealTime()
                 ->MeasureProcessCPUTime()
@@ -219,24 +218,20 @@ void print_ratios(const RatioReporter& rep) {
     const std::string best = flip::default_kernels().name;
     for (const std::string input : {"synthetic", "vectors"})
         for (const std::string pair : {"ldr1080", "hdr1080_9exp"}) {
-            auto name = [&](const std::string& k, int t) {
-                return fmt::format("flip/{}/{}/{}/threads:{}", input, pair, k, t);
-            };
+            auto name = [&](const std::string& k, int t) { return fmt::format("flip/{}/{}/{}/threads:{}", input, pair, k, t); };
             const auto* scalar = rep.find(name("scalar", 1));
             if (!scalar) continue;
             for (const flip::Kernels* k : flip::available_kernels()) {
                 if (k == &flip::scalar_kernels()) continue;
                 if (const auto* v = rep.find(name(k->name, 1)))
-                    std::printf("  %-9s %-13s %-6s vs scalar, 1 thread:  %5.2fx  (%.3f s vs %.3f s CPU)\n",
-                                input.c_str(), pair.c_str(), k->name, scalar->cpu_s / v->cpu_s, v->cpu_s,
-                                scalar->cpu_s);
+                    std::printf("  %-9s %-13s %-6s vs scalar, 1 thread:  %5.2fx  (%.3f s vs %.3f s CPU)\n", input.c_str(),
+                                pair.c_str(), k->name, scalar->cpu_s / v->cpu_s, v->cpu_s, scalar->cpu_s);
             }
             const auto* one = rep.find(name(best, 1));
             const auto* two = rep.find(name(best, 2));
             if (one && two)
-                std::printf("  %-9s %-13s %-6s 2 threads vs 1:       %5.2fx  (%.3f s vs %.3f s wall)\n",
-                            input.c_str(), pair.c_str(), best.c_str(), one->wall_s / two->wall_s, two->wall_s,
-                            one->wall_s);
+                std::printf("  %-9s %-13s %-6s 2 threads vs 1:       %5.2fx  (%.3f s vs %.3f s wall)\n", input.c_str(),
+                            pair.c_str(), best.c_str(), one->wall_s / two->wall_s, two->wall_s, one->wall_s);
         }
     const Vectors& v = vectors();
     if (!v.ok) {
@@ -251,8 +246,7 @@ void print_ratios(const RatioReporter& rep) {
         if (value.is_number()) std::printf("  %-28s %.3f s\n", key.c_str(), value.get<double>());
     std::printf("  (this run, %s, 1 thread, CPU: LDR 1080p %s, HDR 1080p 9 exposures %s; whole-process compare "
                 "512x512 LDR --metric flip %s)\n",
-                best.c_str(),
-                seconds(rep.find("flip/vectors/ldr1080/" + best + "/threads:1")).c_str(),
+                best.c_str(), seconds(rep.find("flip/vectors/ldr1080/" + best + "/threads:1")).c_str(),
                 seconds(rep.find("flip/vectors/hdr1080_9exp/" + best + "/threads:1")).c_str(),
                 seconds(rep.find("BM_CompareProcess512/all_metrics:0")).c_str());
 }

@@ -46,14 +46,14 @@ std::string base64_decode(const std::string& in) {
 bool Browser::available() { return ::access(kChromium, X_OK) == 0; }
 
 Browser::Browser(const std::filesystem::path& profile, int width, int height) : width_(width), height_(height) {
-    ::signal(SIGPIPE, SIG_IGN);  // a browser that died must fail the test, not kill it
+    ::signal(SIGPIPE, SIG_IGN); // a browser that died must fail the test, not kill it
     int to[2], from[2];
     if (::pipe(to) != 0 || ::pipe(from) != 0) throw std::runtime_error("browser: pipe() failed");
     const std::string profile_arg = "--user-data-dir=" + profile.string();
     pid_ = ::fork();
     if (pid_ < 0) throw std::runtime_error("browser: fork() failed");
     if (pid_ == 0) {
-        ::setpgid(0, 0);  // its own process group: the destructor ends Chromium and its helpers together
+        ::setpgid(0, 0); // its own process group: the destructor ends Chromium and its helpers together
         // Out of the way of 3 and 4 first, then onto them (the protocol's fds).
         int r = ::fcntl(to[0], F_DUPFD, 10), w = ::fcntl(from[1], F_DUPFD, 10);
         ::dup2(r, 3);
@@ -63,9 +63,9 @@ Browser::Browser(const std::filesystem::path& profile, int width, int height) : 
         ::dup2(devnull, 0);
         ::dup2(devnull, 1);
         ::dup2(devnull, 2);
-        ::execl(kChromium, "chromium", "--headless", "--no-sandbox", "--disable-gpu", "--remote-debugging-pipe",
-                "--no-first-run", "--disable-background-networking", "--disable-component-update", "--disable-sync",
-                "--hide-scrollbars", "--mute-audio", profile_arg.c_str(), "about:blank", static_cast<char*>(nullptr));
+        ::execl(kChromium, "chromium", "--headless", "--no-sandbox", "--disable-gpu", "--remote-debugging-pipe", "--no-first-run",
+                "--disable-background-networking", "--disable-component-update", "--disable-sync", "--hide-scrollbars",
+                "--mute-audio", profile_arg.c_str(), "about:blank", static_cast<char*>(nullptr));
         ::_exit(127);
     }
     ::close(to[0]);
@@ -83,17 +83,16 @@ Browser::Browser(const std::filesystem::path& profile, int width, int height) : 
 
 Browser::~Browser() {
     if (pid_ > 0) {
-        const int group = pid_;  // the group the child made for itself (setpgid above)
+        const int group = pid_; // the group the child made for itself (setpgid above)
         bool reaped = false;
         try {
             send({{"id", ++next_id_}, {"method", "Browser.close"}});
-        } catch (...) {
-        }
-        for (int i = 0; i < 50 && !reaped; ++i) {  // up to 5 s for a clean exit
+        } catch (...) {}
+        for (int i = 0; i < 50 && !reaped; ++i) { // up to 5 s for a clean exit
             reaped = ::waitpid(group, nullptr, WNOHANG) == group;
             if (!reaped) std::this_thread::sleep_for(std::chrono::milliseconds(100));
         }
-        ::kill(-group, SIGKILL);  // whatever is left of it (helper processes)
+        ::kill(-group, SIGKILL); // whatever is left of it (helper processes)
         if (!reaped) ::waitpid(group, nullptr, 0);
     }
     if (to_browser_ >= 0) ::close(to_browser_);
@@ -135,11 +134,13 @@ void Browser::note_event(const json& m) {
     if (method == "Runtime.exceptionThrown") {
         const json& d = p["exceptionDetails"];
         std::string text = d.value("text", "exception");
-        if (d.contains("exception") && d["exception"].contains("description")) text += ": " + d["exception"]["description"].get<std::string>();
+        if (d.contains("exception") && d["exception"].contains("description"))
+            text += ": " + d["exception"]["description"].get<std::string>();
         errors_.push_back("uncaught " + text);
     } else if (method == "Runtime.consoleAPICalled" && (p.value("type", "") == "error" || p.value("type", "") == "assert")) {
         std::string text;
-        for (const json& a : p["args"]) text += (text.empty() ? "" : " ") + (a.contains("value") ? a["value"].dump() : a.value("description", ""));
+        for (const json& a : p["args"])
+            text += (text.empty() ? "" : " ") + (a.contains("value") ? a["value"].dump() : a.value("description", ""));
         errors_.push_back("console.error " + text);
     } else if (method == "Log.entryAdded" && p["entry"].value("level", "") == "error") {
         errors_.push_back("log " + p["entry"].value("text", "") + " " + p["entry"].value("url", ""));
@@ -179,7 +180,8 @@ json Browser::eval(const std::string& expr) {
     if (r.contains("exceptionDetails")) {
         const json& d = r["exceptionDetails"];
         std::string text = d.value("text", "exception");
-        if (d.contains("exception") && d["exception"].contains("description")) text += ": " + d["exception"]["description"].get<std::string>();
+        if (d.contains("exception") && d["exception"].contains("description"))
+            text += ": " + d["exception"]["description"].get<std::string>();
         throw std::runtime_error("browser: " + expr.substr(0, 120) + ": " + text);
     }
     return r["result"].value("value", json());
@@ -194,9 +196,7 @@ bool Browser::wait_for(const std::string& expr, double timeout_s) {
     return false;
 }
 
-void Browser::mouse_move(double x, double y) {
-    call("Input.dispatchMouseEvent", {{"type", "mouseMoved"}, {"x", x}, {"y", y}});
-}
+void Browser::mouse_move(double x, double y) { call("Input.dispatchMouseEvent", {{"type", "mouseMoved"}, {"x", x}, {"y", y}}); }
 
 void Browser::click(double x, double y) {
     mouse_move(x, y);
@@ -205,10 +205,10 @@ void Browser::click(double x, double y) {
 }
 
 std::pair<double, double> Browser::centre_of(const std::string& selector) {
-    const json r = eval(fmt::format(
-        "(function(){{var el=document.querySelector({});if(!el)return null;el.scrollIntoView({{block:'center'}});"
-        "var b=el.getBoundingClientRect();return [b.left+b.width/2,b.top+b.height/2];}})()",
-        json(selector).dump()));
+    const json r = eval(
+        fmt::format("(function(){{var el=document.querySelector({});if(!el)return null;el.scrollIntoView({{block:'center'}});"
+                    "var b=el.getBoundingClientRect();return [b.left+b.width/2,b.top+b.height/2];}})()",
+                    json(selector).dump()));
     if (!r.is_array()) throw std::runtime_error("browser: nothing matches " + selector);
     return {r[0].get<double>(), r[1].get<double>()};
 }

@@ -36,9 +36,10 @@ int main(int argc, char** argv) {
         iblcheck::testutil::Browser b(profile, width, height);
         const std::string url = "file://" + fs::absolute(index).string() + (tab.empty() ? "" : "#" + tab);
         b.open(url, "document.body && document.body.getAttribute('data-check') === 'done'", 60);
-        const auto facts = b.eval(
-            "({height: document.documentElement.scrollHeight, images: +document.body.getAttribute('data-images-failed'), "
-            "data: +document.body.getAttribute('data-data-failed'), viewers: +document.body.getAttribute('data-viewers-failed')})");
+        const auto facts =
+            b.eval("({height: document.documentElement.scrollHeight, images: +document.body.getAttribute('data-images-failed'), "
+                   "data: +document.body.getAttribute('data-data-failed'), viewers: "
+                   "+document.body.getAttribute('data-viewers-failed')})");
         fmt::print("{}: page height {} px at {}x{}{}\n", index, facts["height"].get<int>(), width, height,
                    tab.empty() ? "" : " (tab " + tab + ")");
         for (const std::string& e : b.errors()) fmt::print("page error: {}\n", e);

@@ -54,7 +54,8 @@ cv::Mat sphere_ids(int w, int h, int rows) {
             const int cx = 24 + 48 * i, cy = h / (2 * rows) + row * h / rows;
             for (int y = std::max(0, cy - r); y <= std::min(h - 1, cy + r); ++y)
                 for (int x = std::max(0, cx - r); x <= std::min(w - 1, cx + r); ++x)
-                    if ((x - cx) * (x - cx) + (y - cy) * (y - cy) <= r * r) ids.at<float>(y, x) = float(1 + row * per_row + i) / 255.0f;
+                    if ((x - cx) * (x - cx) + (y - cy) * (y - cy) <= r * r)
+                        ids.at<float>(y, x) = float(1 + row * per_row + i) / 255.0f;
         }
     return ids;
 }
@@ -102,22 +103,31 @@ json images(const std::string& dir, const std::string& golden) {
 }
 
 json comparison(const std::string& kind, const std::string& dir, const std::string& verdict, double flip) {
-    return json{
-        {"kind", kind},
-        {"golden", kind + "/x.exr"},
-        {"verdict", verdict},
-        {"metrics",
-         {{"flip", {{"mean", flip}, {"weighted_median", flip * 0.8}, {"p99", flip * 10}, {"max", 0.5},
-                    {"block_max", 0.2}, {"block_x", 96}, {"block_y", 16}, {"mode", "hdr"}}},
-          {"ssim", {{"mean", 0.99}}},
-          {"psnr", {{"db", 41.2}, {"rmse", 0.01}, {"max_abs", 0.3}}}}},
-        {"worst_block", {{"x", 96}, {"y", 16}, {"flip", 0.2}, {"sphere", "metal r=0.3"}}},
-        {"checks",
-         json::array({{{"metric", "flip.mean"}, {"value", flip}, {"min", nullptr}, {"max", 0.01},
-                       {"status", flip > 0.01 ? "fail" : "pass"},
-                       {"message", fmt::format("flip.mean {} > 0.01 (+{})", flip, flip - 0.01)}},
-                      {{"metric", "ssim.mean"}, {"value", 0.99}, {"min", 0.98}, {"max", nullptr}, {"status", "pass"}}})},
-        {"images", images(dir, kind)}};
+    return json{{"kind", kind},
+                {"golden", kind + "/x.exr"},
+                {"verdict", verdict},
+                {"metrics",
+                 {{"flip",
+                   {{"mean", flip},
+                    {"weighted_median", flip * 0.8},
+                    {"p99", flip * 10},
+                    {"max", 0.5},
+                    {"block_max", 0.2},
+                    {"block_x", 96},
+                    {"block_y", 16},
+                    {"mode", "hdr"}}},
+                  {"ssim", {{"mean", 0.99}}},
+                  {"psnr", {{"db", 41.2}, {"rmse", 0.01}, {"max_abs", 0.3}}}}},
+                {"worst_block", {{"x", 96}, {"y", 16}, {"flip", 0.2}, {"sphere", "metal r=0.3"}}},
+                {"checks",
+                 json::array({{{"metric", "flip.mean"},
+                               {"value", flip},
+                               {"min", nullptr},
+                               {"max", 0.01},
+                               {"status", flip > 0.01 ? "fail" : "pass"},
+                               {"message", fmt::format("flip.mean {} > 0.01 (+{})", flip, flip - 0.01)}},
+                              {{"metric", "ssim.mean"}, {"value", 0.99}, {"min", 0.98}, {"max", nullptr}, {"status", "pass"}}})},
+                {"images", images(dir, kind)}};
 }
 
 json make_test(const std::string& method, const std::string& scene, const std::string& env, const std::string& variant,
@@ -143,8 +153,8 @@ json make_test(const std::string& method, const std::string& scene, const std::s
     t["image"] = "images/" + dir + "/test.png";
     t["image_exr"] = "images/" + dir + "/test.exr";
     t["layout"] = {{"id_map", "images/" + dir + "/spheres.png"}, {"spheres", sphere_list(4, 1)}};
-    t["comparisons"] = json::array({comparison("baseline", dir, verdict == "fail" ? "fail" : "pass",
-                                               verdict == "fail" ? 0.0123 : 0.004)});
+    t["comparisons"] =
+        json::array({comparison("baseline", dir, verdict == "fail" ? "fail" : "pass", verdict == "fail" ? 0.0123 : 0.004)});
     t["timings"] = json::array({{{"pass", "prefilter_ggx"}, {"ms", 12.1}, {"gpu", true}, {"precompute", true}},
                                 {{"pass", "shade_spheres"}, {"ms", 3.2}, {"gpu", true}, {"precompute", false}}});
     return t;
@@ -153,9 +163,13 @@ json make_test(const std::string& method, const std::string& scene, const std::s
 json per_sphere(double scale) {
     json a = json::array();
     for (double r : {0.1, 0.4, 0.7, 1.0}) {
-        a.push_back({{"label", "metal r=" + std::to_string(r).substr(0, 3)}, {"roughness", r}, {"metallic", 1},
+        a.push_back({{"label", "metal r=" + std::to_string(r).substr(0, 3)},
+                     {"roughness", r},
+                     {"metallic", 1},
                      {"flip_mean", scale * (0.02 + r * 0.05)}});
-        a.push_back({{"label", "plastic r=" + std::to_string(r).substr(0, 3)}, {"roughness", r}, {"metallic", 0},
+        a.push_back({{"label", "plastic r=" + std::to_string(r).substr(0, 3)},
+                     {"roughness", r},
+                     {"metallic", 0},
                      {"flip_mean", scale * (0.01 + r * 0.03)}});
     }
     return a; // 8 spheres
@@ -199,16 +213,24 @@ SmallRun& small_run() {
         t2["precompute_ms"] = 40.1;
         t2["texture_fetches_per_pixel"] = 2.5;
         t2["cost"] = {{"spirv_instructions_per_pixel", 6300.0}, {"texture_fetches_per_pixel", 2.5}};
-        t2["texture_bytes"] = 1048512;  // the prefiltered chain, RGBA16F
+        t2["texture_bytes"] = 1048512; // the prefiltered chain, RGBA16F
         t2["texel_count"] = 131064;
         t2["per_sphere"] = per_sphere(1.0);
         t2["stability"] = {{"noise_floor", {{"flip.mean", 0.0004}}}, {"margins", {{"flip.mean", 25.0}}}, {"flaky", false}};
-        t2["comparisons"][0]["approved"] = {{"commit", "c3"}, {"date", "2026-11-13T03:00:00Z"},
-                                            {"shader_tree_hash", "aaaa"}, {"driver_info", "Mesa 22.3.5"}, {"cpu_class", "avx2"}};
+        t2["comparisons"][0]["approved"] = {{"commit", "c3"},
+                                            {"date", "2026-11-13T03:00:00Z"},
+                                            {"shader_tree_hash", "aaaa"},
+                                            {"driver_info", "Mesa 22.3.5"},
+                                            {"cpu_class", "avx2"}};
         t2["provenance"] = {{"shader_tree_hash", "bbbb"}};
         json ref = comparison("reference", "t2", "pass", 0.052);
-        ref["checks"] = json::array({{{"metric", "accuracy.flip.mean"}, {"value", 0.052}, {"approved", 0.030}, {"min", 0.027},
-                                      {"max", 0.033}, {"status", "fail"}, {"message", "accuracy.flip.mean 0.052 outside"}}});
+        ref["checks"] = json::array({{{"metric", "accuracy.flip.mean"},
+                                      {"value", 0.052},
+                                      {"approved", 0.030},
+                                      {"min", 0.027},
+                                      {"max", 0.033},
+                                      {"status", "fail"},
+                                      {"message", "accuracy.flip.mean 0.052 outside"}}});
         ref["verdict"] = "fail";
         t2["comparisons"].push_back(ref);
         tests.push_back(t2);
@@ -219,7 +241,7 @@ SmallRun& small_run() {
         t3["precompute_ms"] = 38.0;
         t3["texture_fetches_per_pixel"] = 2.0;
         t3["cost"] = {{"spirv_instructions_per_pixel", 6200.0}};
-        t3["texture_bytes"] = 62976;  // ASTC 6x6
+        t3["texture_bytes"] = 62976; // ASTC 6x6
         tests.push_back(t3);
 
         json t4 = make_test("mobile", "furnace", "constant", "", "missing-golden", "t4");
@@ -240,8 +262,11 @@ SmallRun& small_run() {
         t6["frame_ms"] = 3.5;
         t6["precompute_ms"] = 41.0;
         t6["texture_fetches_per_pixel"] = 2.5;
-        t6["temporal"] = {{"frames", json::array()}, {"reference_frames", json::array()}, {"flicker", 0.01},
-                          {"variation_ratio", 1.3}, {"flip_mean", 0.02}};
+        t6["temporal"] = {{"frames", json::array()},
+                          {"reference_frames", json::array()},
+                          {"flicker", 0.01},
+                          {"variation_ratio", 1.3},
+                          {"flip_mean", 0.02}};
         for (int i = 0; i < 12; ++i) {
             t6["temporal"]["frames"].push_back(fmt::format("images/t6/frame{:03d}.png", i));
             t6["temporal"]["reference_frames"].push_back(fmt::format("images/t6/ref{:03d}.png", i));
@@ -280,8 +305,11 @@ SmallRun& small_run() {
                      {"dirty", true},
                      {"cpu_class", "avx2"},
                      {"driver",
-                      {{"device", "llvmpipe (LLVM 15.0.6, 256 bits)"}, {"driver", "llvmpipe"},
-                       {"driver_info", "Mesa 22.3.6 (LLVM 15.0.6)"}, {"mesa", "22.3.6"}, {"llvm", "15.0.6"},
+                      {{"device", "llvmpipe (LLVM 15.0.6, 256 bits)"},
+                       {"driver", "llvmpipe"},
+                       {"driver_info", "Mesa 22.3.6 (LLVM 15.0.6)"},
+                       {"mesa", "22.3.6"},
+                       {"llvm", "15.0.6"},
                        {"api", "1.3.230"}}},
                      {"counts", {{"pass", 5}, {"fail", 1}, {"improved", 1}, {"missing-golden", 1}, {"error", 1}}},
                      {"tests", tests}};
@@ -338,7 +366,7 @@ CiRun make_ci_run(const fs::path& dir, int passing, bool failing) {
         const std::string d = "images/" + name + "/";
         cv::Mat test = spheres(W, H, 2, 1.0f + 0.01f * float(k), env == "sky_sun");
         cv::Mat base = test.clone();
-        if (fail) {  // the baseline differs on metal r=0.5 (index 5): 30 % brighter there
+        if (fail) { // the baseline differs on metal r=0.5 (index 5): 30 % brighter there
             const int cx = 24 + 48 * 5, cy = H / 4;
             for (int y = 0; y < H / 2; ++y)
                 for (int x = cx - 22; x <= cx + 22; ++x)
@@ -351,15 +379,25 @@ CiRun make_ci_run(const fs::path& dir, int passing, bool failing) {
         write_error(dir, d + "baseline_flip.png", err);
         write_png((dir / (d + "spheres.png")).string(), sphere_ids(W, H, 2));
         json imgs = images(name, "baseline");
-        if (!fail) imgs["golden_exr"] = imgs["test_exr"];  // bit-identical: the harness shares the file
-        json t = {{"name", name}, {"suite", "ci"}, {"scene", "roughness_sweep"}, {"method", "mobile"}, {"env", env},
-                  {"variant", variant}, {"options", json::object()}, {"width", W}, {"height", H},
-                  {"verdict", fail ? "fail" : "pass"}, {"image", d + "test.png"}, {"image_exr", d + "test.exr"},
+        if (!fail) imgs["golden_exr"] = imgs["test_exr"]; // bit-identical: the harness shares the file
+        json t = {{"name", name},
+                  {"suite", "ci"},
+                  {"scene", "roughness_sweep"},
+                  {"method", "mobile"},
+                  {"env", env},
+                  {"variant", variant},
+                  {"options", json::object()},
+                  {"width", W},
+                  {"height", H},
+                  {"verdict", fail ? "fail" : "pass"},
+                  {"image", d + "test.png"},
+                  {"image_exr", d + "test.exr"},
                   {"layout", {{"id_map", d + "spheres.png"}, {"spheres", spheres_json}}},
                   {"bless_command", "iblcheck bless --suite 'ci' --filter '" + name + "'"},
                   {"accuracy", {{"flip_mean", 0.2 + 0.001 * k}}},
                   {"cost", {{"spirv_instructions_per_pixel", 6276.0 + k}, {"texture_fetches_per_pixel", 2.54}}},
-                  {"frame_ms", 150.0 + k}, {"precompute_ms", 200.0}};
+                  {"frame_ms", 150.0 + k},
+                  {"precompute_ms", 200.0}};
         double mean = 0;
         int over = 0;
         for (int y = 0; y < H; ++y)
@@ -368,16 +406,27 @@ CiRun make_ci_run(const fs::path& dir, int passing, bool failing) {
                 over += err.at<float>(y, x) > 0.02f;
             }
         mean /= W * H;
-        json cmp = {{"kind", "baseline"}, {"golden", "baseline/" + name + ".exr"}, {"verdict", fail ? "fail" : "pass"},
+        json cmp = {{"kind", "baseline"},
+                    {"golden", "baseline/" + name + ".exr"},
+                    {"verdict", fail ? "fail" : "pass"},
                     {"images", imgs},
-                    {"approved", {{"commit", "da34be9deabf"}, {"date", "2026-11-23T03:15:06Z"},
-                                  {"shader_tree_hash", fail ? "d7aa188baa82dc22" : "3f2167d7d4701f9b"},
-                                  {"driver_info", "Mesa 22.3.6 (LLVM 15.0.6)"}, {"cpu_class", "avx2-fma-f16c-256"}}},
+                    {"approved",
+                     {{"commit", "da34be9deabf"},
+                      {"date", "2026-11-23T03:15:06Z"},
+                      {"shader_tree_hash", fail ? "d7aa188baa82dc22" : "3f2167d7d4701f9b"},
+                      {"driver_info", "Mesa 22.3.6 (LLVM 15.0.6)"},
+                      {"cpu_class", "avx2-fma-f16c-256"}}},
                     {"metrics", {{"flip", {{"mean", mean}, {"block_x", 240}, {"block_y", 16}}}}},
-                    {"checks", json::array({{{"metric", "flip.mean"}, {"value", mean}, {"min", nullptr}, {"max", 0.001},
+                    {"checks", json::array({{{"metric", "flip.mean"},
+                                             {"value", mean},
+                                             {"min", nullptr},
+                                             {"max", 0.001},
                                              {"status", fail ? "fail" : "pass"},
                                              {"message", fmt::format("flip.mean {:.4g} > 0.001", mean)}},
-                                            {{"metric", "flip.p99"}, {"value", 0.3}, {"min", nullptr}, {"max", 0.02},
+                                            {{"metric", "flip.p99"},
+                                             {"value", 0.3},
+                                             {"min", nullptr},
+                                             {"max", 0.02},
                                              {"status", fail ? "fail" : "pass"}}})}};
         if (fail) cmp["worst_block"] = {{"x", 240}, {"y", 16}, {"flip", 0.26}, {"sphere", "metal r=0.5"}};
         t["comparisons"] = json::array({cmp});
@@ -393,11 +442,20 @@ CiRun make_ci_run(const fs::path& dir, int passing, bool failing) {
     };
     if (failing) one(passing, true);
     for (int k = 0; k < passing; ++k) one(k, false);
-    run.results = {{"schema", "iblcheck-results/1"}, {"suite", "ci"}, {"command", "iblcheck run --suite ci --out report"},
-                   {"started", "2026-11-23T06:12:15Z"}, {"total_s", 27.6}, {"commit", "039aeff2a6fb"}, {"dirty", false},
+    run.results = {{"schema", "iblcheck-results/1"},
+                   {"suite", "ci"},
+                   {"command", "iblcheck run --suite ci --out report"},
+                   {"started", "2026-11-23T06:12:15Z"},
+                   {"total_s", 27.6},
+                   {"commit", "039aeff2a6fb"},
+                   {"dirty", false},
                    {"cpu_class", "avx2-fma-f16c-256"},
-                   {"driver", {{"device", "llvmpipe (LLVM 15.0.6, 256 bits)"}, {"driver_info", "Mesa 22.3.6 (LLVM 15.0.6)"},
-                               {"mesa", "22.3.6"}, {"llvm", "15.0.6"}, {"api", "1.3.230"}}},
+                   {"driver",
+                    {{"device", "llvmpipe (LLVM 15.0.6, 256 bits)"},
+                     {"driver_info", "Mesa 22.3.6 (LLVM 15.0.6)"},
+                     {"mesa", "22.3.6"},
+                     {"llvm", "15.0.6"},
+                     {"api", "1.3.230"}}},
                    {"tests", tests}};
     std::ofstream(dir / "results.json") << run.results.dump(1);
     return run;

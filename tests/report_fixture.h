@@ -28,8 +28,8 @@ struct CiRun {
     std::filesystem::path dir;
     nlohmann::json results;
     std::string failing_name;
-    cv::Mat failing_test, failing_error;  // linear RGB CV_32FC3 and FLIP-like map CV_32FC1
-    int pixels_over_002 = 0;              // of failing_error (the mask's default threshold 0.02)
+    cv::Mat failing_test, failing_error; // linear RGB CV_32FC3 and FLIP-like map CV_32FC1
+    int pixels_over_002 = 0;             // of failing_error (the mask's default threshold 0.02)
     int width = 528, height = 96;
 };
 CiRun make_ci_run(const std::filesystem::path& dir, int passing, bool failing);

@@ -55,8 +55,8 @@ double relative_rms(const std::vector<float>& in, const AstcRoundTrip& rt, const
 } // namespace
 
 TEST(AstcStorage, BytesAreSixteenPerBlockWithPartialBlocksWhole) {
-    EXPECT_EQ(astc_image_bytes(128, 128, 4), 32u * 32 * 16);  // 8 bits a texel
-    EXPECT_EQ(astc_image_bytes(128, 128, 6), 22u * 22 * 16);  // 128/6 = 21.3 → 22 blocks a side
+    EXPECT_EQ(astc_image_bytes(128, 128, 4), 32u * 32 * 16); // 8 bits a texel
+    EXPECT_EQ(astc_image_bytes(128, 128, 6), 22u * 22 * 16); // 128/6 = 21.3 → 22 blocks a side
     EXPECT_EQ(astc_image_bytes(1, 1, 4), 16u);
     EXPECT_EQ(astc_image_bytes(2, 2, 6), 16u);
     EXPECT_EQ(astc_image_bytes(7, 5, 6), 2u * 1 * 16);
@@ -82,16 +82,16 @@ TEST(AstcStorage, RgbmEncodeKeepsTheRangeAndTheMinimumMultiplier) {
     float out[4];
     const float bright[3] = {3.0f, 1.5f, 0.75f};
     rgbm_encode(bright, 6.0f, out);
-    EXPECT_FLOAT_EQ(out[3], 0.5f);  // max 3 / range 6
+    EXPECT_FLOAT_EQ(out[3], 0.5f); // max 3 / range 6
     EXPECT_FLOAT_EQ(out[0], 1.0f);
     EXPECT_FLOAT_EQ(out[0] * out[3] * 6.0f, 3.0f);
     EXPECT_FLOAT_EQ(out[2] * out[3] * 6.0f, 0.75f);
-    const float dark[3] = {0.01f, 0.0f, -1.0f};  // negatives clamp to 0
+    const float dark[3] = {0.01f, 0.0f, -1.0f}; // negatives clamp to 0
     rgbm_encode(dark, 6.0f, out);
     EXPECT_FLOAT_EQ(out[3], kAstcRgbmMinM);
     EXPECT_NEAR(out[0] * out[3] * 6.0f, 0.01f, 1e-7);
     EXPECT_EQ(out[2], 0.0f);
-    const float over[3] = {60.0f, 6.0f, 0.0f};  // above the range: clipped at range
+    const float over[3] = {60.0f, 6.0f, 0.0f}; // above the range: clipped at range
     rgbm_encode(over, 6.0f, out);
     EXPECT_FLOAT_EQ(out[3], 1.0f);
     EXPECT_FLOAT_EQ(out[0], 1.0f);
@@ -115,7 +115,8 @@ TEST(AstcStorage, ConstantImagesRoundTripToTheirFp16Value) {
             for (size_t i = 0; i < 144; ++i) {
                 float m = profile == AstcProfile::ldr_rgbm ? half_bits_to_float(rt.decoded_half[4 * i + 3]) * 6.0f : 1.0f;
                 for (int c = 0; c < 3; ++c)
-                    worst = std::max(worst, double(std::fabs(half_bits_to_float(rt.decoded_half[4 * i + c]) * m - colour[c]) / colour[c]));
+                    worst = std::max(
+                        worst, double(std::fabs(half_bits_to_float(rt.decoded_half[4 * i + c]) * m - colour[c]) / colour[c]));
             }
             EXPECT_LT(worst, profile == AstcProfile::hdr ? std::ldexp(1.0, -11) : 3 * std::ldexp(1.0, -11))
                 << "block " << block << (profile == AstcProfile::hdr ? " hdr" : " rgbm");
@@ -138,8 +139,8 @@ TEST(AstcStorage, SmoothHdrFieldWithinTheMeasuredErrorAnd6x6CostsAccuracy) {
         double bound;
     };
     double err[2][2] = {};
-    for (Case c : {Case{AstcProfile::hdr, 4, 0.013}, Case{AstcProfile::hdr, 6, 0.03},
-                   Case{AstcProfile::ldr_rgbm, 4, 0.038}, Case{AstcProfile::ldr_rgbm, 6, 0.065}}) {
+    for (Case c : {Case{AstcProfile::hdr, 4, 0.013}, Case{AstcProfile::hdr, 6, 0.03}, Case{AstcProfile::ldr_rgbm, 4, 0.038},
+                   Case{AstcProfile::ldr_rgbm, 6, 0.065}}) {
         AstcFormat f{c.profile, c.block, 6.0f};
         // RGBM clips above its range: scale the field into it for the LDR profile.
         std::vector<float> in = img;
@@ -149,12 +150,13 @@ TEST(AstcStorage, SmoothHdrFieldWithinTheMeasuredErrorAnd6x6CostsAccuracy) {
         AstcRoundTrip rt = codec.round_trip(in.data(), w, h);
         double e = relative_rms(in, rt, f, c.profile == AstcProfile::hdr ? 0.0 : 0.06);
         err[c.profile == AstcProfile::hdr ? 0 : 1][c.block == 4 ? 0 : 1] = e;
-        std::printf("[ astc ] %s %ux%u relative RMS %.4g, encode %.3g ms\n", c.profile == AstcProfile::hdr ? "hdr" : "rgbm", c.block, c.block, e, rt.encode_ms);
+        std::printf("[ astc ] %s %ux%u relative RMS %.4g, encode %.3g ms\n", c.profile == AstcProfile::hdr ? "hdr" : "rgbm",
+                    c.block, c.block, e, rt.encode_ms);
         EXPECT_LT(e, c.bound) << (c.profile == AstcProfile::hdr ? "hdr " : "rgbm ") << c.block;
-        EXPECT_GT(e, 0.0);  // a lossy format: nothing passes by being skipped
+        EXPECT_GT(e, 0.0); // a lossy format: nothing passes by being skipped
         EXPECT_GE(rt.encode_ms, 0.0);
     }
-    EXPECT_GT(err[0][1], err[0][0]);  // 6x6 (3.56 bpp) loses more than 4x4 (8 bpp)
+    EXPECT_GT(err[0][1], err[0][0]); // 6x6 (3.56 bpp) loses more than 4x4 (8 bpp)
     EXPECT_GT(err[1][1], err[1][0]);
 }
 
@@ -170,5 +172,5 @@ TEST(AstcStorage, HalfBitsDecode) {
     EXPECT_EQ(half_bits_to_float(0x3c00), 1.0f);
     EXPECT_EQ(half_bits_to_float(0xc000), -2.0f);
     EXPECT_EQ(half_bits_to_float(0x7bff), 65504.0f);
-    EXPECT_EQ(half_bits_to_float(0x0001), std::ldexp(1.0f, -24));  // smallest subnormal
+    EXPECT_EQ(half_bits_to_float(0x0001), std::ldexp(1.0f, -24)); // smallest subnormal
 }

@@ -48,8 +48,7 @@ cv::Mat gradient(int w, int h, float shift) {
     cv::Mat m(h, w, CV_32FC3);
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x)
-            for (int c = 0; c < 3; ++c)
-                m.ptr<float>(y)[3 * x + c] = std::min(1.0f, float(x + y + 5 * c) / float(w + h) + shift);
+            for (int c = 0; c < 3; ++c) m.ptr<float>(y)[3 * x + c] = std::min(1.0f, float(x + y + 5 * c) / float(w + h) + shift);
     return m;
 }
 

@@ -10,8 +10,8 @@
 #include <sstream>
 #include <sys/wait.h>
 
-#include "tests/test_support.h"
 #include "renderers/vulkan/cpu_caps.h"
+#include "tests/test_support.h"
 
 using namespace iblcheck;
 
@@ -28,13 +28,12 @@ const char* kIvyBridge = "fpu sse sse2 pni ssse3 sse4_1 sse4_2 popcnt xsave avx 
 // A Nehalem: SSE4.2, no AVX.
 const char* kNehalem = "fpu sse sse2 pni ssse3 sse4_1 sse4_2 popcnt";
 
-
 } // namespace
 
 TEST(CpuCaps, ThisMachineUnchanged) {
     LlvmpipeCaps c = llvmpipe_caps_from(kEpyc, nullptr, nullptr);
     EXPECT_TRUE(c.sse && c.sse2 && c.sse3 && c.ssse3 && c.sse41 && c.avx && c.avx2 && c.f16c && c.fma && c.avx512);
-    EXPECT_EQ(c.vector_width, 256);  // AVX-512 does not widen it: llvmpipe caps it at 256
+    EXPECT_EQ(c.vector_width, 256); // AVX-512 does not widen it: llvmpipe caps it at 256
     EXPECT_EQ(c.override_caps, "");
     EXPECT_EQ(c.warning, "");
     EXPECT_EQ(c.cpu_class(), "avx2-fma-f16c-256");
@@ -47,13 +46,11 @@ TEST(CpuCaps, EachOverrideClearsItsLevelAndEverythingAbove) {
         int width;
         const char* cls;
     };
-    for (const Case& k : {Case{"nosse", 0, 0, 0, 0, 0, 0, 0, 128, "nosse"},
-                          Case{"sse", 1, 0, 0, 0, 0, 0, 0, 128, "sse-128"},
-                          Case{"sse2", 1, 1, 0, 0, 0, 0, 0, 128, "sse2-128"},
-                          Case{"sse3", 1, 1, 1, 0, 0, 0, 0, 128, "sse3-128"},
-                          Case{"ssse3", 1, 1, 1, 1, 0, 0, 0, 128, "ssse3-128"},
-                          Case{"sse4.1", 1, 1, 1, 1, 1, 0, 0, 128, "sse4.1-128"},
-                          Case{"avx", 1, 1, 1, 1, 1, 1, 0, 256, "avx2-fma-f16c-256"}}) {
+    for (const Case& k :
+         {Case{"nosse", 0, 0, 0, 0, 0, 0, 0, 128, "nosse"}, Case{"sse", 1, 0, 0, 0, 0, 0, 0, 128, "sse-128"},
+          Case{"sse2", 1, 1, 0, 0, 0, 0, 0, 128, "sse2-128"}, Case{"sse3", 1, 1, 1, 0, 0, 0, 0, 128, "sse3-128"},
+          Case{"ssse3", 1, 1, 1, 1, 0, 0, 0, 128, "ssse3-128"}, Case{"sse4.1", 1, 1, 1, 1, 1, 0, 0, 128, "sse4.1-128"},
+          Case{"avx", 1, 1, 1, 1, 1, 1, 0, 256, "avx2-fma-f16c-256"}}) {
         LlvmpipeCaps c = llvmpipe_caps_from(kEpyc, k.value, nullptr);
         SCOPED_TRACE(k.value);
         EXPECT_EQ(c.override_caps, k.value);
@@ -83,7 +80,7 @@ TEST(CpuCaps, UnrecognisedOverrideChangesNothingAndWarns) {
         EXPECT_EQ(c.override_caps, v);
         EXPECT_NE(c.warning.find(std::string("'") + v + "'"), std::string::npos) << c.warning;
     }
-    EXPECT_EQ(llvmpipe_caps_from(kEpyc, "", nullptr).warning, "");  // set but empty: nothing to warn about
+    EXPECT_EQ(llvmpipe_caps_from(kEpyc, "", nullptr).warning, ""); // set but empty: nothing to warn about
 }
 
 TEST(CpuCaps, NativeVectorWidthOverridesAsMesaParsesIt) {
@@ -105,8 +102,8 @@ TEST(CpuCaps, OlderCpusAndCpuinfoText) {
     // FMA/F16C flags without AVX (an OS that does not save YMM hides avx): Mesa drops them.
     EXPECT_EQ(llvmpipe_caps_from("sse sse2 pni ssse3 sse4_1 fma f16c avx2", nullptr, nullptr).cpu_class(), "sse4.1-128");
     // All of /proc/cpuinfo: the first processor's flags line is used, other lines are not flags.
-    std::string text = "processor\t: 0\nmodel name\t: Some CPU with sse in its name avx2\nflags\t\t: " +
-                       std::string(kNehalem) + "\n\nprocessor\t: 1\nflags\t\t: " + kEpyc + "\n";
+    std::string text = "processor\t: 0\nmodel name\t: Some CPU with sse in its name avx2\nflags\t\t: " + std::string(kNehalem) +
+                       "\n\nprocessor\t: 1\nflags\t\t: " + kEpyc + "\n";
     EXPECT_EQ(llvmpipe_caps_from(text, nullptr, nullptr).cpu_class(), "sse4.1-128");
 }
 
@@ -122,9 +119,9 @@ TEST(CpuCaps, AgreesWithMesasOwnDumpOnThisMachine) {
         const char* override_caps;
         const char* width;
     };
-    for (const Run& r : {Run{nullptr, nullptr}, Run{"nosse", nullptr}, Run{"sse", nullptr}, Run{"sse2", nullptr},
-                         Run{"sse3", nullptr}, Run{"ssse3", nullptr}, Run{"sse4.1", nullptr}, Run{"avx", nullptr},
-                         Run{"avx2", nullptr}, Run{nullptr, "128"}}) {
+    for (const Run& r :
+         {Run{nullptr, nullptr}, Run{"nosse", nullptr}, Run{"sse", nullptr}, Run{"sse2", nullptr}, Run{"sse3", nullptr},
+          Run{"ssse3", nullptr}, Run{"sse4.1", nullptr}, Run{"avx", nullptr}, Run{"avx2", nullptr}, Run{nullptr, "128"}}) {
         std::string env = "GALLIUM_DUMP_CPU=true ";
         if (r.override_caps) env += std::string("GALLIUM_OVERRIDE_CPU_CAPS=") + r.override_caps + " ";
         if (r.width) env += std::string("LP_NATIVE_VECTOR_WIDTH=") + r.width + " ";

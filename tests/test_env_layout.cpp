@@ -63,7 +63,7 @@ TEST(EnvLayout, EveryBorderTexelContinuesTheMapAcrossItsSeam) {
     // map's largest step; a wrong fold puts it up to π away), and not on top of it (at least 0.3
     // of the next step inward; clamping to the edge instead of wrapping puts it at 0).
     for (EnvLayout layout : {EnvLayout::octahedral, EnvLayout::equirect}) {
-        const uint32_t w = layout == EnvLayout::octahedral ? 34 : 66, h = 34;  // inner 32x32, 64x32
+        const uint32_t w = layout == EnvLayout::octahedral ? 34 : 66, h = 34; // inner 32x32, 64x32
         double pitch = 0;
         for (uint32_t y = 1; y + 1 < h; ++y)
             for (uint32_t x = 1; x + 1 < w; ++x) {
@@ -141,7 +141,7 @@ TEST(EnvLayout, ExtentsTexelCountsAndMipLimits) {
     EXPECT_EQ(layout_texel_count(EnvLayout::cube, 128, 7), 6u * 21844);
     EXPECT_EQ(layout_texel_count(EnvLayout::octahedral, 128, 7), 87376u);
     EXPECT_EQ(layout_texel_count(EnvLayout::equirect, 128, 7), 2u * 87376);
-    EXPECT_NO_THROW(check_layout_mips(EnvLayout::octahedral, 128, 7));  // last level 4x4: 2x2 inside
+    EXPECT_NO_THROW(check_layout_mips(EnvLayout::octahedral, 128, 7)); // last level 4x4: 2x2 inside
     EXPECT_THROW(check_layout_mips(EnvLayout::octahedral, 128, 8), UsageError);
     EXPECT_NO_THROW(check_layout_mips(EnvLayout::cube, 128, 8));
     EXPECT_THROW(env_layout_from_option("sphere"), UsageError);

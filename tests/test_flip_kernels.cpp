@@ -4,8 +4,8 @@
 // depend on the CI machine's SIMD width).
 #include <gtest/gtest.h>
 
-#include <array>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -40,8 +40,8 @@ cv::Mat test_image(int w, int h, unsigned seed, bool hdr) {
             for (int c = 0; c < 3; ++c) {
                 const float smooth = 0.5f + 0.4f * std::sin(0.13f * float(x + 7 * c) + 0.05f * float(y));
                 float v = std::min(1.0f, std::max(0.0f, smooth + 0.2f * (u(rng) - 0.5f)));
-                m.ptr<float>(y)[3 * x + c] = hdr ? v * std::exp2(12.0f * float(x) / float(w) - 6.0f)
-                                                 : std::round(v * 255.0f) / 255.0f;
+                m.ptr<float>(y)[3 * x + c] =
+                    hdr ? v * std::exp2(12.0f * float(x) / float(w) - 6.0f) : std::round(v * 255.0f) / 255.0f;
             }
     return m;
 }
@@ -108,7 +108,7 @@ TEST_P(KernelVariants, PixelMathMatchesScalarBitForBit) {
     std::vector<std::vector<float>> planes(16);
     for (int i = 0; i < 16; ++i) {
         const int c = i % 8;
-        planes[size_t(i)] = c == 0 ? random_values(n, unsigned(10 + i), -5, 110)
+        planes[size_t(i)] = c == 0  ? random_values(n, unsigned(10 + i), -5, 110)
                             : c < 4 ? random_values(n, unsigned(10 + i), -120, 120)
                                     : random_values(n, unsigned(10 + i), -1, 1);
     }
@@ -135,8 +135,7 @@ TEST_P(KernelVariants, FlipMatchesScalarBitForBitAtAnyThreadCount) {
     };
     // Widths around the 256-column strips and the 8/16/32-pixel blocks; tiny images below the
     // filters' radius; a tall narrow one (row bands when threads > strips).
-    for (const Case c : {Case{300, 77, false}, Case{517, 33, true}, Case{7, 9, false}, Case{256, 40, true},
-                         Case{40, 300, false},
+    for (const Case c : {Case{300, 77, false}, Case{517, 33, true}, Case{7, 9, false}, Case{256, 40, true}, Case{40, 300, false},
                          Case{90, 70, false, 400.0}}) { // 400 ppd: filters of 109 taps
         const cv::Mat a = test_image(c.w, c.h, 1, c.hdr), b = test_image(c.w, c.h, 2, c.hdr);
         FlipOptions ref_opts;

@@ -15,11 +15,11 @@
 #include <random>
 #include <sys/wait.h>
 
-#include "tests/test_support.h"
 #include "harness/common/errors.h"
 #include "renderers/option_table.h"
 #include "renderers/vulkan/context.h"
 #include "renderers/vulkan/fp16_emulation.h"
+#include "tests/test_support.h"
 
 namespace fs = std::filesystem;
 using namespace iblcheck;
@@ -27,8 +27,6 @@ using namespace iblcheck;
 namespace {
 
 using namespace iblcheck::testutil;
-
-
 
 vk::Context& context() {
     static vk::Context ctx({"", true});
@@ -48,15 +46,13 @@ vk::CompiledShader compile(const std::string& name, const std::string& glsl, boo
 }
 
 // Runs `shader` on `inputs` (binding 0) → `outputs` floats (binding 1); push constant: item count.
-std::vector<float> dispatch(const vk::CompiledShader& shader, const std::vector<float>& inputs, uint32_t items,
-                            size_t outputs) {
+std::vector<float> dispatch(const vk::CompiledShader& shader, const std::vector<float>& inputs, uint32_t items, size_t outputs) {
     vk::Context& ctx = context();
     vk::Buffer in = ctx.create_buffer(inputs.size() * 4), out = ctx.create_buffer(outputs * 4);
     std::memcpy(in.mapped, inputs.data(), inputs.size() * 4);
     vk::ComputePipeline p(ctx, shader, {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}, 4);
     ctx.submit([&](VkCommandBuffer cmd) {
-        p.dispatch(cmd, {vk::Binding::storage_buffer(0, in), vk::Binding::storage_buffer(1, out)}, &items, 4,
-                   (items + 63) / 64);
+        p.dispatch(cmd, {vk::Binding::storage_buffer(0, in), vk::Binding::storage_buffer(1, out)}, &items, 4, (items + 63) / 64);
         vk::Context::barrier(cmd);
     });
     EXPECT_EQ(ctx.validation_errors(), 0) << (ctx.validation_messages().empty() ? "" : ctx.validation_messages()[0]);
@@ -133,8 +129,8 @@ std::vector<float> random_halves(size_t n, uint32_t seed) {
     std::vector<float> v(n);
     for (float& f : v) {
         uint16_t bits = uint16_t(rng() & 0xffff);
-        if ((bits & 0x7c00) == 0x7c00) bits &= 0xbfff;  // no inf/NaN: exponent 31 → 15
-        if ((bits & 0x7c00) == 0) bits |= 0x0400;       // no subnormal inputs
+        if ((bits & 0x7c00) == 0x7c00) bits &= 0xbfff; // no inf/NaN: exponent 31 → 15
+        if ((bits & 0x7c00) == 0) bits |= 0x0400;      // no subnormal inputs
         _Float16 h;
         std::memcpy(&h, &bits, 2);
         f = float(h);
@@ -149,7 +145,7 @@ bool same_value(float a, float b) { return same_bits(a, b) || (std::isnan(a) && 
 
 TEST(Fp16EmulationPass, OutputValidatesWithoutAnyFloat16) {
     vk::CompiledShader native = compile("a.comp", kArithmetic, false);
-    ASSERT_TRUE(has_float16_capability(native.spirv));  // the input of the pass does use fp16
+    ASSERT_TRUE(has_float16_capability(native.spirv)); // the input of the pass does use fp16
     ASSERT_EQ(count_f16_types(native.spirv), 1);
     EXPECT_EQ(vk::validate_spirv(native.spirv), "");
 
@@ -159,15 +155,15 @@ TEST(Fp16EmulationPass, OutputValidatesWithoutAnyFloat16) {
     EXPECT_EQ(vk::validate_spirv(m), "");
     EXPECT_FALSE(has_float16_capability(m));
     EXPECT_EQ(count_f16_types(m), 0);
-    EXPECT_EQ(count_op(m, 115 /*OpFConvert*/), 0);  // f32→f16 became quantizes, f16→f32 copies
+    EXPECT_EQ(count_op(m, 115 /*OpFConvert*/), 0); // f32→f16 became quantizes, f16→f32 copies
     EXPECT_EQ(count_op(m, 148 /*OpDot*/), 0);
     EXPECT_EQ(st.dots_expanded, 1);
-    EXPECT_GE(st.constants, 1);                     // float16_t(0.25)
+    EXPECT_GE(st.constants, 1); // float16_t(0.25)
     // One conversion in (half_in is one function), + − × ÷ sqrt, the dot product's 3 products
     // and 2 sums.
     EXPECT_EQ(st.rounded, 1 + 5 + 5);
     EXPECT_EQ(count_round_even(m), st.rounded);
-    EXPECT_EQ(count_op(m, 116 /*OpQuantizeToF16*/), 0);  // lavapipe cannot run it without F16C
+    EXPECT_EQ(count_op(m, 116 /*OpQuantizeToF16*/), 0); // lavapipe cannot run it without F16C
 
     // The compiler applies it when asked, and keys the cache apart.
     vk::CompiledShader emulated = compile("a.comp", kArithmetic, true);
@@ -265,8 +261,8 @@ TEST(Fp16EmulationDispatch, RandomOperandsMatchNativeAndIeeeFp16BitForBit) {
     std::vector<float> in = random_halves(2 * n, 15);
     std::vector<float> emulated = dispatch(compile("arith.comp", kArithmetic, true), in, n, size_t(n) * kOps);
     bool has_native = context().info().shader_float16;
-    std::vector<float> native = has_native ? dispatch(compile("arith.comp", kArithmetic, false), in, n, size_t(n) * kOps)
-                                           : std::vector<float>();
+    std::vector<float> native =
+        has_native ? dispatch(compile("arith.comp", kArithmetic, false), in, n, size_t(n) * kOps) : std::vector<float>();
     int mismatches[kOps] = {}, native_mismatches[kOps] = {}, subnormals = 0, overflows = 0;
     for (uint32_t i = 0; i < n; ++i)
         for (int k = 0; k < kOps; ++k) {

@@ -105,7 +105,7 @@ TEST(FragmentShading, BoxDownsampleAveragesBlocksAndAlpha) {
     // Block 0: pixels 0, 1, 4, 5 -> mean index 2.5; block 1: 2, 3, 6, 7 -> 4.5 (channel c adds c).
     EXPECT_FLOAT_EQ(rgb.at<cv::Vec3f>(0, 0)[0], 2.5f);
     EXPECT_FLOAT_EQ(rgb.at<cv::Vec3f>(0, 1)[2], 6.5f);
-    EXPECT_DOUBLE_EQ(alpha, (5.5 + 7.5) / 2);  // alpha = index + 3
+    EXPECT_DOUBLE_EQ(alpha, (5.5 + 7.5) / 2); // alpha = index + 3
 }
 
 TEST(FragmentShading, MetalFurnaceIdentityHoldsAndInteriorsMatchCompute) {
@@ -130,7 +130,6 @@ TEST(FragmentShading, MetalFurnaceIdentityHoldsAndInteriorsMatchCompute) {
     EXPECT_LT(max_interior_rel_difference(f.image, c.image, interior), kInteriorRel);
     expect_no_validation_errors();
 }
-
 
 TEST(FragmentShading, DielectricFurnaceIdentityHolds) {
     // White dielectric in constant:1: Lambert gives 1, the specular lobe adds 0.04·A + B.
@@ -163,7 +162,7 @@ TEST(FragmentShading, SilhouettesGetPerSampleCoverage) {
     RenderResult f = render(spec("furnace", "constant:1", {{"storage", "rgba32f"}, {"shading", "fragment"}}));
     int count[5] = {0, 0, 0, 0, 0};
     for (int y = 0; y < f.image.rows; ++y)
-        for (int x = 0; x < 64; ++x) {  // the first cell: the r = 0 sphere
+        for (int x = 0; x < 64; ++x) { // the first cell: the r = 0 sphere
             double v = f.image.at<cv::Vec3f>(y, x)[0], q = std::round(v * 4);
             ASSERT_NEAR(v, q / 4, 2e-3) << x << "," << y;
             ++count[int(q)];

@@ -15,11 +15,11 @@
 #include <fstream>
 #include <limits>
 
-#include "tests/test_support.h"
 #include "harness/common/errors.h"
 #include "harness/golden_store.h"
 #include "harness/runner.h"
 #include "metrics/image_io.h"
+#include "tests/test_support.h"
 
 namespace fs = std::filesystem;
 using namespace iblcheck;
@@ -29,10 +29,7 @@ namespace {
 
 using namespace iblcheck::testutil;
 
-
-
 std::string bin(const std::string& name) { return std::string(IBLCHECK_BINARY_DIR) + "/" + name; }
-
 
 const char* kMiniSuite = R"({
   "suite": "mini",
@@ -108,7 +105,8 @@ TEST(GateHoles, GoldenWithoutItsSidecarIsAnErrorNamingTheFile) {
     EXPECT_EQ(t["verdict"], "error");
     std::string msg = t["message"];
     EXPECT_NE(msg.find(fs::path(s.baseline()).replace_extension(".json").string() + ": golden sidecar missing"),
-              std::string::npos) << msg;
+              std::string::npos)
+        << msg;
 }
 
 TEST(GateHoles, GoldenOfTheWrongSizeFailsWithBothSizesAndTheReportIsStillWritten) {
@@ -130,7 +128,9 @@ TEST(GateHoles, GoldenOfTheWrongSizeFailsWithBothSizesAndTheReportIsStillWritten
     EXPECT_TRUE(fs::exists(out / "index.html"));
     std::string report_out;
     EXPECT_EQ(run_command(bin("iblcheck") + " report " + (out / "results.json").string() + " --out " + (s.dir / "rep").string(),
-                          report_out), 0) << report_out;
+                          report_out),
+              0)
+        << report_out;
 }
 
 TEST(GateHoles, ShaderThatWritesNanIsARegressionForRunBisectAndRender) {
@@ -140,16 +140,18 @@ TEST(GateHoles, ShaderThatWritesNanIsARegressionForRunBisectAndRender) {
                                        "sum / float(n * n) * uintBitsToFloat(0x7fc00000u); // a quiet NaN");
     std::string out;
     const std::string filter = " --filter 'mobile.roughness_sweep.studio.default'";
-    EXPECT_EQ(run_command(env + bin("iblcheck") + " run --suite ci -q --json " + (dir / "r.json").string() + filter, out), 1) << out;
+    EXPECT_EQ(run_command(env + bin("iblcheck") + " run --suite ci -q --json " + (dir / "r.json").string() + filter, out), 1)
+        << out;
     json r = json::parse(read_text(dir / "r.json"));
     EXPECT_EQ(r["tests"][0]["verdict"], "fail");
     EXPECT_NE(r["tests"][0]["message"].get<std::string>().find("non-finite value(s) (NaN/Inf), first at x=0, y=0"),
-              std::string::npos) << r["tests"][0]["message"];
+              std::string::npos)
+        << r["tests"][0]["message"];
     EXPECT_EQ(run_command(env + bin("iblcheck") + " bisect" + filter, out), 1) << out;
     EXPECT_NE(out.find("bisect verdict: bad"), std::string::npos) << out;
     EXPECT_EQ(run_command(env + bin("iblcheck") + " render --scene sphere --out " + (dir / "nan.exr").string(), out), 1) << out;
     EXPECT_NE(out.find("non-finite"), std::string::npos) << out;
-    EXPECT_TRUE(fs::exists(dir / "nan.exr"));  // written first, to be inspected
+    EXPECT_TRUE(fs::exists(dir / "nan.exr")); // written first, to be inspected
     fs::remove_all(dir);
 }
 
@@ -161,13 +163,14 @@ TEST(GateHoles, BlessLeavesUnchangedGoldensUntouchedAndPrintsOnlyAfterWriting) {
     EXPECT_EQ(run_command(s.cli("bless"), out), 0) << out;
     EXPECT_NE(out.find("unchanged, left as it is"), std::string::npos) << out;
     EXPECT_EQ(fs::last_write_time(s.baseline()), t_img);
-    EXPECT_EQ(read_text(fs::path(s.baseline()).replace_extension(".json")), side);  // no new date: no git churn
+    EXPECT_EQ(read_text(fs::path(s.baseline()).replace_extension(".json")), side); // no new date: no git churn
 
     // A store whose baseline folder cannot be written: an error naming it, and never "blessed".
     fs::path broken = s.dir / "broken";
     fs::create_directories(broken / "reference");
     std::ofstream(broken / "baseline") << "a file where the folder should be";
-    EXPECT_EQ(run_command(bin("iblcheck") + " bless --suite " + s.suite.string() + " --goldens " + broken.string(), out), 2) << out;
+    EXPECT_EQ(run_command(bin("iblcheck") + " bless --suite " + s.suite.string() + " --goldens " + broken.string(), out), 2)
+        << out;
     EXPECT_EQ(out.find("\nblessed"), std::string::npos) << out;
     EXPECT_NE(out.rfind("blessed", 0), 0u) << out;
     EXPECT_NE(out.find((broken / "baseline").string()), std::string::npos) << out;
@@ -177,15 +180,16 @@ TEST(GateHoles, BlessLabelsAreFileNamesOnly) {
     MiniStore s("labels");
     const std::string side = read_text(fs::path(s.baseline()).replace_extension(".json"));
     std::string out;
-    EXPECT_EQ(run_command(s.cli("bless --label ''"), out), 2) << out;  // used to overwrite the primary baseline
-    EXPECT_EQ(run_command(s.cli("bless --label ../../evil"), out), 2) << out;  // used to write outside the store
+    EXPECT_EQ(run_command(s.cli("bless --label ''"), out), 2) << out;         // used to overwrite the primary baseline
+    EXPECT_EQ(run_command(s.cli("bless --label ../../evil"), out), 2) << out; // used to write outside the store
     EXPECT_NE(out.find("A-Z a-z 0-9 . _ -"), std::string::npos) << out;
     EXPECT_FALSE(fs::exists(s.dir / "evil.exr"));
     EXPECT_FALSE(fs::exists(s.goldens / "evil.exr"));
     EXPECT_EQ(read_text(fs::path(s.baseline()).replace_extension(".json")), side);
     // A good label records the platform it was blessed on.
     EXPECT_EQ(run_command(s.cli("bless --label amd-zen4"), out), 0) << out;
-    json prov = json::parse(read_text(fs::path(GoldenStore(s.goldens).baseline_path(kMiniTest, "amd-zen4")).replace_extension(".json")));
+    json prov =
+        json::parse(read_text(fs::path(GoldenStore(s.goldens).baseline_path(kMiniTest, "amd-zen4")).replace_extension(".json")));
     EXPECT_EQ(prov["label"], "amd-zen4");
     for (const char* k : {"driver", "cpu_features", "cpu_class"}) EXPECT_TRUE(prov.contains(k)) << k;
 }
@@ -197,7 +201,7 @@ TEST(GateHoles, BlessCommandPrintedForASuiteGivenByPathWorks) {
     RunSummary r = s.run();
     ASSERT_EQ(r.results["tests"][0]["verdict"], "missing-golden") << r.results["tests"][0]["message"];
     std::string cmd = r.results["tests"][0]["bless_command"];
-    EXPECT_NE(cmd.find(s.suite.string()), std::string::npos) << cmd;  // the path, not the name "mini"
+    EXPECT_NE(cmd.find(s.suite.string()), std::string::npos) << cmd; // the path, not the name "mini"
     std::string out;
     ASSERT_EQ(cmd.rfind("iblcheck ", 0), 0u);
     EXPECT_EQ(run_command("cd / && " + bin("iblcheck") + cmd.substr(8) + " --goldens " + s.goldens.string(), out), 0) << out;
@@ -210,7 +214,7 @@ TEST(GateHoles, SecondRunIntoTheSameOutFolderIsRefused) {
     fs::create_directories(out);
     int fd = ::open((out / ".iblcheck.lock").c_str(), O_RDWR | O_CREAT, 0644);
     ASSERT_GE(fd, 0);
-    ASSERT_EQ(::flock(fd, LOCK_EX), 0);  // as a running iblcheck holds it
+    ASSERT_EQ(::flock(fd, LOCK_EX), 0); // as a running iblcheck holds it
     std::string text;
     EXPECT_EQ(run_command(s.cli("run -q --out " + out.string()), text), 2) << text;
     EXPECT_NE(text.find("another iblcheck run"), std::string::npos) << text;
@@ -225,14 +229,17 @@ TEST(GateHoles, CtestFormNeverPassesWithoutRunning) {
     const std::string ci = bin("tests/test_suite_ci");
     EXPECT_EQ(run_command(ci + " --gtest_filter=ci.no_such_test", out), 1) << out;
     EXPECT_NE(out.find("ran no test"), std::string::npos) << out;
-    EXPECT_EQ(run_command("IBLCHECK_GOLDEN_DIR=/nonexistent " + ci + " --gtest_filter=ci.mobile.furnace.constant_1.default", out), 1) << out;
+    EXPECT_EQ(run_command("IBLCHECK_GOLDEN_DIR=/nonexistent " + ci + " --gtest_filter=ci.mobile.furnace.constant_1.default", out),
+              1)
+        << out;
     EXPECT_NE(out.find("missing-golden"), std::string::npos) << out;
     EXPECT_NE(out.find("1 FAILED TEST"), std::string::npos) << out;
     // The first ci test belongs to shard 0 of 3: shard 1 reports it skipped, shard 0 runs it.
     const std::string first = " --gtest_filter=ci.mobile.roughness_sweep.studio.default";
     EXPECT_EQ(run_command("GTEST_SHARD_INDEX=1 GTEST_TOTAL_SHARDS=3 " + ci + first, out), 0) << out;
     EXPECT_NE(out.find("[  SKIPPED ] 1 test"), std::string::npos) << out;
-    EXPECT_EQ(run_command("IBLCHECK_GOLDEN_DIR=/nonexistent GTEST_SHARD_INDEX=0 GTEST_TOTAL_SHARDS=3 " + ci + first, out), 1) << out;
+    EXPECT_EQ(run_command("IBLCHECK_GOLDEN_DIR=/nonexistent GTEST_SHARD_INDEX=0 GTEST_TOTAL_SHARDS=3 " + ci + first, out), 1)
+        << out;
 }
 
 TEST(GateHoles, TwiceAsMuchShadingWorkFailsOnCostAndTheFigureIsDeterministic) {
@@ -241,12 +248,13 @@ TEST(GateHoles, TwiceAsMuchShadingWorkFailsOnCostAndTheFigureIsDeterministic) {
     // fails past +25 %. Here every ray is shaded twice (the image is bit-identical, so only the
     // cost can catch it).
     fs::path dir = temp_dir("twice");
-    std::string env = modified_shaders(dir, "shade_spheres.comp",
-                                       "sum += shade_ray(vec2(px) + (vec2(i, j) + 0.5) / float(n));",
-                                       "{ vec2 p = vec2(px) + (vec2(i, j) + 0.5) / float(n); sum += 0.5 * (shade_ray(p) + shade_ray(p)); }");
+    std::string env =
+        modified_shaders(dir, "shade_spheres.comp", "sum += shade_ray(vec2(px) + (vec2(i, j) + 0.5) / float(n));",
+                         "{ vec2 p = vec2(px) + (vec2(i, j) + 0.5) / float(n); sum += 0.5 * (shade_ray(p) + shade_ray(p)); }");
     std::string out;
     const std::string filter = " --filter 'mobile.roughness_sweep.*.default'";
-    EXPECT_EQ(run_command(env + bin("iblcheck") + " run --suite ci -q --json " + (dir / "r.json").string() + filter, out), 1) << out;
+    EXPECT_EQ(run_command(env + bin("iblcheck") + " run --suite ci -q --json " + (dir / "r.json").string() + filter, out), 1)
+        << out;
     json r = json::parse(read_text(dir / "r.json"));
     ASSERT_EQ(r["tests"].size(), 2u);
     for (const json& t : r["tests"]) {
@@ -262,7 +270,6 @@ TEST(GateHoles, TwiceAsMuchShadingWorkFailsOnCostAndTheFigureIsDeterministic) {
     ASSERT_EQ(run_command(bin("iblcheck") + " run --suite ci -q --json " + (dir / "b.json").string() + filter, out), 0) << out;
     a = json::parse(read_text(dir / "a.json"));
     b = json::parse(read_text(dir / "b.json"));
-    for (size_t i = 0; i < 2; ++i)
-        EXPECT_EQ(a["tests"][i]["cost"], b["tests"][i]["cost"]);
+    for (size_t i = 0; i < 2; ++i) EXPECT_EQ(a["tests"][i]["cost"], b["tests"][i]["cost"]);
     fs::remove_all(dir);
 }

@@ -22,7 +22,7 @@ fs::path temp_dir() {
     static fs::path p = [] {
         fs::path d = fs::temp_directory_path() / ("iblcheck_test_graphics_" + std::to_string(::getpid()));
         fs::create_directories(d);
-        setenv("IBLCHECK_CACHE_DIR", (d / "cache").c_str(), 1);  // a private SPIR-V cache
+        setenv("IBLCHECK_CACHE_DIR", (d / "cache").c_str(), 1); // a private SPIR-V cache
         return d;
     }();
     return p;
@@ -144,7 +144,7 @@ TEST(GraphicsPipeline, InstructionCountCoversEveryFragmentDiscardedOrNot) {
     if (!context().info().int64_atomics || !context().info().graphics_stores) GTEST_SKIP() << "device cannot count";
     // Same image with and without the counter.
     Push keep{{1, 1, 1, 1}, 0.5f, 0xF, 0}, half{{1, 1, 1, 1}, 0.5f, 0xF, 4}, none{{1, 1, 1, 1}, 0.5f, 0xF, 8},
-        clipped{{1, 1, 1, 1}, 2.0f, 0xF, 0};  // depth 2: outside the clip volume, no fragment
+        clipped{{1, 1, 1, 1}, 2.0f, 0xF, 0}; // depth 2: outside the clip volume, no fragment
     auto count = [&](const Push& p, std::vector<float>* image) {
         vk::Buffer total = context().create_buffer(8);
         auto px = counted.draw({p}, {vk::Binding::storage_buffer(vk::kCostBinding, total)});
@@ -167,7 +167,7 @@ TEST(GraphicsPipeline, InstructionCountCoversEveryFragmentDiscardedOrNot) {
     const uint64_t kept = (all - vertices) / 64, dropped = (all_discarded - vertices) / 64;
     EXPECT_LT(dropped, kept);
     EXPECT_EQ(left_discarded, vertices + 32 * kept + 32 * dropped);
-    EXPECT_EQ(count(keep, nullptr), all);  // deterministic
+    EXPECT_EQ(count(keep, nullptr), all); // deterministic
     expect_no_validation_errors();
 }
 

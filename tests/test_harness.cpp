@@ -13,11 +13,11 @@
 #include <set>
 #include <sys/wait.h>
 
-#include "tests/test_support.h"
 #include "harness/common/errors.h"
 #include "harness/golden_store.h"
 #include "harness/runner.h"
 #include "harness/suite.h"
+#include "tests/test_support.h"
 
 namespace fs = std::filesystem;
 using namespace iblcheck;
@@ -26,9 +26,6 @@ using nlohmann::json;
 namespace {
 
 using namespace iblcheck::testutil;
-
-
-
 
 std::string iblcheck_bin() { return std::string(IBLCHECK_BINARY_DIR) + "/iblcheck"; }
 
@@ -68,7 +65,8 @@ TEST(Suite, SchemaErrorsNameFileKeyAndProblem) {
          "unknown option(s) for method mobile: no_such"},
         {R"({"suite": "x", "tests": [{"scene": "sphere", "method": "mobile", "baseline_tolerances": {"flip.mean": {"maximum": 1}}}]})",
          "tests[0].baseline_tolerances.flip.mean.maximum: unknown key"},
-        {R"({"suite": "x", "tests": [{"scene": "sphere", "method": "mobile", "size": "big"}]})", "tests[0].size: 'big' is not WxH"},
+        {R"({"suite": "x", "tests": [{"scene": "sphere", "method": "mobile", "size": "big"}]})",
+         "tests[0].size: 'big' is not WxH"},
         {R"({"suite": "x", "tests": [{"scene": "sphere", "method": "mobile", "size": 64}]})",
          "tests[0].size: must be a string, not number"},
         {R"({"suite": "x", "tests": [{"scene": "sphere", "method": "mobile"}, {"scene": "sphere", "method": "mobile"}]})",
@@ -91,7 +89,8 @@ TEST(Suite, ShippedSuitesLoadAndExpand) {
     EXPECT_GE(ci.tests.size(), 30u);
     std::set<std::string> scenes;
     for (auto& t : ci.tests) scenes.insert(t.spec.scene);
-    for (const char* s : {"sphere", "roughness_sweep", "furnace", "furnace_dielectric", "grazing"}) EXPECT_TRUE(scenes.count(s)) << s;
+    for (const char* s : {"sphere", "roughness_sweep", "furnace", "furnace_dielectric", "grazing"})
+        EXPECT_TRUE(scenes.count(s)) << s;
     for (const char* name : {"nightly", "temporal", "stability"}) EXPECT_NO_THROW(load_suite(name)) << name;
 }
 
@@ -107,7 +106,7 @@ TEST(Suite, TemporalReferenceIsSharedAndTakesReferenceOptions) {
     tc.temporal.frames = 8;
     tc.temporal.reference_ssaa = 8;
     TestSpec same_path = temporal_reference_spec(tc);
-    EXPECT_EQ(same_path.options.canonical(), "shading=fragment,specular_aa=off,ssaa=8");  // fragment's ssaa defaults to 1
+    EXPECT_EQ(same_path.options.canonical(), "shading=fragment,specular_aa=off,ssaa=8"); // fragment's ssaa defaults to 1
     tc.temporal.reference_options.set("shading", "compute");
     TestSpec ref = temporal_reference_spec(tc);
     EXPECT_EQ(ref.options.canonical(), "shading=compute,specular_aa=off,ssaa=8");
@@ -118,7 +117,7 @@ TEST(Suite, TemporalReferenceIsSharedAndTakesReferenceOptions) {
     EXPECT_EQ(without_specular_aa(other.spec).options.canonical(), without_specular_aa(tc.spec).options.canonical());
     tc.spec.options.set("shading", "compute");
     tc.temporal.reference_options = OptionMap();
-    EXPECT_EQ(temporal_reference_spec(tc).options.get_int("ssaa", 0), 16);  // compute's ssaa defaults to 2
+    EXPECT_EQ(temporal_reference_spec(tc).options.get_int("ssaa", 0), 16); // compute's ssaa defaults to 2
 }
 
 TEST(Suite, ShardsPartitionTheSuite) {
@@ -168,7 +167,8 @@ TEST(Harness, MissingGoldenThenBlessThenPassThenImproved) {
     fs::create_directories(goldens / "reference");
     // A reference golden for the furnace: the test's accuracy is measured against it.
     for (const char* ext : {".exr", ".json"})
-        fs::copy(fs::path(IBLCHECK_SOURCE_DIR) / (std::string("goldens/reference/furnace__constant-1") + ext), goldens / "reference");
+        fs::copy(fs::path(IBLCHECK_SOURCE_DIR) / (std::string("goldens/reference/furnace__constant-1") + ext),
+                 goldens / "reference");
 
     RunOptions o;
     o.suite = (dir / "mini.json").string();
@@ -180,7 +180,8 @@ TEST(Harness, MissingGoldenThenBlessThenPassThenImproved) {
     EXPECT_EQ(s1.exit_code(), kExitRegression);
     std::string msg = s1.results["tests"][0]["message"];
     EXPECT_NE(msg.find("iblcheck bless --suite '" + o.suite + "' --filter 'mobile.furnace.constant:1.default'"),
-              std::string::npos) << msg;
+              std::string::npos)
+        << msg;
 
     BlessOptions b;
     b.suite = o.suite;
@@ -220,23 +221,28 @@ TEST(Harness, MissingGoldenThenBlessThenPassThenImproved) {
 
     // A second approved baseline (@label) is accepted when the primary no longer matches.
     cv::Mat img = GoldenStore(goldens).baselines("mobile.furnace.constant:1.default")[0].image.clone();
-    GoldenStore::write_golden(GoldenStore(goldens).baseline_path("mobile.furnace.constant:1.default", "other-platform"),
-                              img, prov);
+    GoldenStore::write_golden(GoldenStore(goldens).baseline_path("mobile.furnace.constant:1.default", "other-platform"), img,
+                              prov);
     img.setTo(cv::Scalar(0.2, 0.2, 0.2));
     GoldenStore::write_golden(golden, img, prov);
     RunSummary s4 = run_suite(o);
     for (auto& t : s4.results["tests"])
         if (t["name"] == "mobile.furnace.constant:1.default") {
-            EXPECT_EQ(t["verdict"], "improved");  // passes the @other-platform baseline; accuracy as above
+            EXPECT_EQ(t["verdict"], "improved"); // passes the @other-platform baseline; accuracy as above
             EXPECT_EQ(t["comparisons"][0]["label"], "other-platform");
         }
     fs::remove_all(dir);
 }
 
 TEST(Harness, JUnitIsWellFormedAndCountsFailures) {
-    json results = {{"suite", "s"}, {"total_s", 1.5}, {"started", "2026-01-01T00:00:00Z"},
+    json results = {{"suite", "s"},
+                    {"total_s", 1.5},
+                    {"started", "2026-01-01T00:00:00Z"},
                     {"tests", json::array({{{"name", "a<b"}, {"method", "mobile"}, {"verdict", "pass"}, {"wall_s", 0.1}},
-                                           {{"name", "c&d"}, {"method", "mobile"}, {"verdict", "fail"}, {"message", "flip \"x\""},
+                                           {{"name", "c&d"},
+                                            {"method", "mobile"},
+                                            {"verdict", "fail"},
+                                            {"message", "flip \"x\""},
                                             {"bless_command", "iblcheck bless --filter 'c&d'"}},
                                            {{"name", "e"}, {"verdict", "missing-golden"}, {"message", "m"}},
                                            {{"name", "f"}, {"verdict", "error"}, {"message", "boom"}}})}};
@@ -244,12 +250,14 @@ TEST(Harness, JUnitIsWellFormedAndCountsFailures) {
     write_junit(results, dir / "j.xml");
     // Validate with Python's XML parser (stdlib): well-formed, and the counts add up.
     std::string out;
-    int rc = run_command("python3 -c \"import sys, xml.etree.ElementTree as E; r = E.parse(sys.argv[1]).getroot(); "
-                         "s = r.find('testsuite'); c = s.findall('testcase'); "
-                         "print(r.tag, s.get('tests'), s.get('failures'), s.get('errors'), len(c), "
-                         "len([x for x in c if x.find('failure') is not None]), len([x for x in c if x.find('error') is not None]), "
-                         "c[0].get('name'))\" " + (dir / "j.xml").string(),
-                         out);
+    int rc =
+        run_command("python3 -c \"import sys, xml.etree.ElementTree as E; r = E.parse(sys.argv[1]).getroot(); "
+                    "s = r.find('testsuite'); c = s.findall('testcase'); "
+                    "print(r.tag, s.get('tests'), s.get('failures'), s.get('errors'), len(c), "
+                    "len([x for x in c if x.find('failure') is not None]), len([x for x in c if x.find('error') is not None]), "
+                    "c[0].get('name'))\" " +
+                        (dir / "j.xml").string(),
+                    out);
     if (rc == 127) GTEST_SKIP() << "python3 not found: cannot validate the XML";
     EXPECT_EQ(rc, 0) << out;
     EXPECT_EQ(out, "testsuites 4 2 1 4 2 1 a<b\n");
@@ -310,10 +318,12 @@ TEST(Gate, ShaderChangeFailsExactlyTheAffectedCiTestsAndBisectFollowsTheContract
         out, std::regex(R"(\n +accuracy vs truth: 0\.\d{4} -> 0\.\d{4} \([+-]\d+\.\d %\), band \[0\.\d{4}, 0\.\d{4}\]\n)")))
         << out;
     EXPECT_NE(out.find("\n          approve: iblcheck bless --suite 'ci' --filter 'mobile.roughness_sweep.studio.default'\n"),
-              std::string::npos) << out;
+              std::string::npos)
+        << out;
     EXPECT_NE(out.find("approve all 1 failure (after looking at them): iblcheck bless --suite 'ci' --filter "
                        "'mobile.roughness_sweep.studio.default'\n"),
-              std::string::npos) << out;
+              std::string::npos)
+        << out;
 
     // Without the change the suite passes again.
     rc = run_command(iblcheck_bin() + " run --suite ci -q", out);
@@ -353,7 +363,10 @@ TEST(Cli, BadInputExitsTwo) {
 TEST(Cli, RenderReportsTheEnvironmentTexture) {
     // The prefiltered chain's texels and bytes (7 levels of a 128 cube; ASTC 4x4: 16 bytes a block).
     std::string out;
-    ASSERT_EQ(run_command(iblcheck_bin() + " render --scene sphere --env constant:1 --set storage=astc_hdr --json - 2>/dev/null", out), 0) << out;
+    ASSERT_EQ(
+        run_command(iblcheck_bin() + " render --scene sphere --env constant:1 --set storage=astc_hdr --json - 2>/dev/null", out),
+        0)
+        << out;
     auto j = nlohmann::json::parse(out.substr(out.find('{')));
     EXPECT_EQ(j["texture_bytes"].get<uint64_t>(), 6u * 16 * (1024 + 256 + 64 + 16 + 4 + 1 + 1));
     EXPECT_EQ(j["texel_count"].get<uint64_t>(), 6u * 21844);
@@ -376,16 +389,23 @@ TEST(Temporal, BrokenSpecularAntiAliasingFailsTheGate) {
     Suite shipped = load_suite("temporal");
     const TestCase* claim = nullptr;
     for (auto& t : shipped.tests)
-        if (t.spec.scene == "bumpy_sphere" && t.spec.env == "sky_sun" && t.spec.options.get_string("specular_aa", "") == "toksvig")
+        if (t.spec.scene == "bumpy_sphere" && t.spec.env == "sky_sun" &&
+            t.spec.options.get_string("specular_aa", "") == "toksvig")
             claim = &t;
     ASSERT_NE(claim, nullptr);
     ASSERT_TRUE(claim->temporal.checks.count("flicker_ratio"));
-    json suite = {{"suite", "temporal_broken"},
-                  {"tests", json::array({{{"scene", "bumpy_sphere"}, {"method", "mobile"}, {"env", "sky_sun"},
-                                          {"baseline", false}, {"reference", false},
-                                          {"options", {{"ssaa", 1}, {"specular_aa", "toksvig"}, {"specular_aa_variance", 0}}},
-                                          {"temporal", {{"frames", claim->temporal.frames},
-                                                        {"checks", {{"flicker_ratio", {{"max", *claim->temporal.checks.at("flicker_ratio").max}}}}}}}}})}};
+    json suite = {
+        {"suite", "temporal_broken"},
+        {"tests",
+         json::array({{{"scene", "bumpy_sphere"},
+                       {"method", "mobile"},
+                       {"env", "sky_sun"},
+                       {"baseline", false},
+                       {"reference", false},
+                       {"options", {{"ssaa", 1}, {"specular_aa", "toksvig"}, {"specular_aa_variance", 0}}},
+                       {"temporal",
+                        {{"frames", claim->temporal.frames},
+                         {"checks", {{"flicker_ratio", {{"max", *claim->temporal.checks.at("flicker_ratio").max}}}}}}}}})}};
     fs::path dir = temp_dir("temporal_broken");
     write_file(dir / "broken.json", suite.dump());
     RunOptions o;

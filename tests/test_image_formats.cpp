@@ -40,11 +40,16 @@ void write_oiio(const std::string& file, int w, int h, int nch, OIIO::TypeDesc t
     ASSERT_TRUE(out) << OIIO::geterror();
     OIIO::ImageSpec spec(w, h, nch, type);
     for (const auto& [k, v] : attrs) {
-        if (k == "tile") spec.tile_width = spec.tile_height = std::stoi(v);
-        else if (k == "x") spec.x = std::stoi(v);
-        else if (k == "y") spec.y = std::stoi(v);
-        else if (k == "png:bitdepth" || k == "oiio:BitsPerSample") spec.attribute(k, std::stoi(v));
-        else spec.attribute(k, v);
+        if (k == "tile")
+            spec.tile_width = spec.tile_height = std::stoi(v);
+        else if (k == "x")
+            spec.x = std::stoi(v);
+        else if (k == "y")
+            spec.y = std::stoi(v);
+        else if (k == "png:bitdepth" || k == "oiio:BitsPerSample")
+            spec.attribute(k, std::stoi(v));
+        else
+            spec.attribute(k, v);
     }
     if (!channel_names.empty()) spec.channelnames = channel_names;
     if (nch == 2 || nch == 4) spec.alpha_channel = nch - 1;
@@ -77,8 +82,7 @@ void expect_same_as_oiio(const std::string& file, const std::string& native_read
 
 // A palette or grey PNG of `depth` bits per sample from sample values `v` (row-major, one per
 // pixel), optionally with a tRNS chunk (palette: per-entry alpha; grey: one transparent value).
-bool png_body(png_structp png, png_infop info, FILE* f, int w, int h, int depth, bool palette, bool trns,
-              png_bytepp rows) {
+bool png_body(png_structp png, png_infop info, FILE* f, int w, int h, int depth, bool palette, bool trns, png_bytepp rows) {
     if (setjmp(png_jmpbuf(png))) return false;
     png_init_io(png, f);
     png_set_IHDR(png, info, png_uint_32(w), png_uint_32(h), depth, palette ? PNG_COLOR_TYPE_PALETTE : PNG_COLOR_TYPE_GRAY,
@@ -93,8 +97,10 @@ bool png_body(png_structp png, png_infop info, FILE* f, int w, int h, int depth,
     key.gray = png_uint_16(1);
     if (palette) png_set_PLTE(png, info, pal, 1 << depth);
     if (trns) {
-        if (palette) png_set_tRNS(png, info, alpha, 1 << depth, nullptr);
-        else png_set_tRNS(png, info, nullptr, 0, &key);
+        if (palette)
+            png_set_tRNS(png, info, alpha, 1 << depth, nullptr);
+        else
+            png_set_tRNS(png, info, nullptr, 0, &key);
     }
     png_write_info(png, info);
     png_write_image(png, rows);
@@ -140,7 +146,8 @@ TEST_F(ImageFormats, PngLayoutsMatchOpenImageIO) {
     const int w = 13, h = 7;
     for (int nch : {1, 2, 3, 4})
         for (auto type : {OIIO::TypeDesc::UINT8, OIIO::TypeDesc::UINT16}) {
-            const std::string f = path("c" + std::to_string(nch) + "_" + std::to_string(int(OIIO::TypeDesc(type).size())) + ".png");
+            const std::string f =
+                path("c" + std::to_string(nch) + "_" + std::to_string(int(OIIO::TypeDesc(type).size())) + ".png");
             write_oiio(f, w, h, nch, type, ramp(w, h, nch, 1.0f, unsigned(nch)));
             expect_same_as_oiio(f, "libpng");
         }
@@ -172,7 +179,8 @@ TEST_F(ImageFormats, ExrLayoutsMatchOpenImageIO) {
     const int w = 11, h = 6;
     for (int nch : {1, 2, 3, 4})
         for (auto type : {OIIO::TypeDesc::HALF, OIIO::TypeDesc::FLOAT}) {
-            const std::string f = path("c" + std::to_string(nch) + "_" + std::to_string(int(OIIO::TypeDesc(type).size())) + ".exr");
+            const std::string f =
+                path("c" + std::to_string(nch) + "_" + std::to_string(int(OIIO::TypeDesc(type).size())) + ".exr");
             // Two channels: grey + alpha (OpenImageIO would name them R, G by default).
             write_oiio(f, w, h, nch, type, ramp(w, h, nch, 100.0f, unsigned(nch) + 10), {},
                        nch == 2 ? std::vector<std::string>{"Y", "A"} : std::vector<std::string>{});

@@ -41,7 +41,9 @@ TEST(JsonChecker, ValuesMustHaveTheirTypeAndSayWhatTheyAre) {
 TEST(JsonChecker, KeysListTheValidOnes) {
     const JsonChecker c("f.json");
     EXPECT_NO_THROW(c.keys(json{{"min", 1}}, "b", {"min", "max"}));
-    EXPECT_EQ(error_of([&] { c.keys(json{{"maximum", 1}}, "b", {"min", "max"}); }),
+    EXPECT_EQ(error_of([&] {
+                  c.keys(json{{"maximum", 1}}, "b", {"min", "max"});
+              }),
               "f.json: b.maximum: unknown key; valid: max, min");
     EXPECT_EQ(error_of([&] { c.keys(json::array(), "b", {"min"}); }), "f.json: b: must be an object, not array");
 }
@@ -56,6 +58,7 @@ TEST(JsonChecker, MembersAreOptionalUnlessRequiredAndTyped) {
     EXPECT_NE(c.member(obj, "t", "list", JsonType::array), nullptr);
     EXPECT_EQ(error_of([&] { c.member(obj, "t", "absent", JsonType::string, true); }), "r.json: t: missing key 'absent'");
     EXPECT_EQ(error_of([&] { c.member(obj, "t", "name", JsonType::number); }), "r.json: t: 'name' must be a number, not string");
-    EXPECT_EQ(error_of([&] { c.member(obj, "t", "ms", JsonType::boolean); }), "r.json: t: 'ms' must be true or false, not number");
+    EXPECT_EQ(error_of([&] { c.member(obj, "t", "ms", JsonType::boolean); }),
+              "r.json: t: 'ms' must be true or false, not number");
     EXPECT_EQ(error_of([&] { c.member(obj, "t", "list", JsonType::object); }), "r.json: t: 'list' must be an object, not array");
 }

@@ -19,8 +19,8 @@
 #include "harness/common/errors.h"
 #include "metrics/display_transform.h"
 #include "metrics/flip.h"
-#include "metrics/flip_json.h"
 #include "metrics/flip/magma_table.h"
+#include "metrics/flip_json.h"
 #include "metrics/image_io.h"
 
 namespace fs = std::filesystem;
@@ -30,9 +30,9 @@ namespace {
 
 const fs::path kVectors = fs::path(IBLCHECK_SHARED_DIR) / "flip-vectors";
 
-#define REQUIRE_VECTORS()                                                                        \
-    if (!fs::exists(kVectors / "expected.json"))                                                 \
-    GTEST_SKIP() << kVectors.string() << " not found: the FLIP test vectors (expected.json, "    \
+#define REQUIRE_VECTORS()                                                                                                        \
+    if (!fs::exists(kVectors / "expected.json"))                                                                                 \
+    GTEST_SKIP() << kVectors.string() << " not found: the FLIP test vectors (expected.json, "                                    \
                  << "image pairs, reference error maps) live in the shared folder beside the checkout"
 
 nlohmann::json expected() {
@@ -55,8 +55,7 @@ const FlipResult& flip_for(const std::string& name) {
     const auto p = pair_named(name);
     const auto ref = read_image((kVectors / p["reference"].get<std::string>()).string());
     const auto test = read_image((kVectors / p["test"].get<std::string>()).string());
-    FlipResult r = p["mode"] == "hdr" ? compute_flip_hdr(ref.pixels, test.pixels)
-                                      : compute_flip_ldr(ref.pixels, test.pixels);
+    FlipResult r = p["mode"] == "hdr" ? compute_flip_hdr(ref.pixels, test.pixels) : compute_flip_ldr(ref.pixels, test.pixels);
     return cache.emplace(name, std::move(r)).first->second;
 }
 
@@ -82,9 +81,9 @@ TEST_P(FlipVectors, AgreesWithReferenceTool) {
             if (d > max_delta) max_delta = d, mx = x, my = y;
         }
     }
-    std::cout << "[ " << GetParam() << " ] max per-pixel |delta| = " << max_delta << " at (" << mx
-              << ", " << my << "); mean " << r.mean << " vs " << p["mean_double"].get<double>()
-              << " (delta " << r.mean - p["mean_double"].get<double>() << ")\n";
+    std::cout << "[ " << GetParam() << " ] max per-pixel |delta| = " << max_delta << " at (" << mx << ", " << my << "); mean "
+              << r.mean << " vs " << p["mean_double"].get<double>() << " (delta " << r.mean - p["mean_double"].get<double>()
+              << ")\n";
     EXPECT_LE(max_delta, 2e-4) << "at x=" << mx << ", y=" << my;
 
     EXPECT_NEAR(r.mean, p["mean_double"].get<double>(), 1e-5);
@@ -106,8 +105,7 @@ TEST_P(FlipVectors, AgreesWithReferenceTool) {
     EXPECT_LE(r.block_max, r.max);
 }
 
-INSTANTIATE_TEST_SUITE_P(AllPairs, FlipVectors,
-                         ::testing::Values("gen512_ldr", "gen512_hdr", "ref1080_ldr", "ramp1080_hdr"));
+INSTANTIATE_TEST_SUITE_P(AllPairs, FlipVectors, ::testing::Values("gen512_ldr", "gen512_hdr", "ref1080_ldr", "ramp1080_hdr"));
 
 // Random image of a given size, sRGB values in [0,1] with smooth structure plus noise.
 cv::Mat synthetic(int w, int h, unsigned seed, float noise) {
@@ -181,9 +179,7 @@ TEST(Flip, ExplicitExposuresAreUsed) {
     EXPECT_THROW(compute_flip_hdr(a, b, o), UsageError);
 }
 
-TEST(Flip, SizeMismatchThrows) {
-    EXPECT_THROW(compute_flip_ldr(synthetic(32, 32, 1, 0), synthetic(33, 32, 1, 0)), InputError);
-}
+TEST(Flip, SizeMismatchThrows) { EXPECT_THROW(compute_flip_ldr(synthetic(32, 32, 1, 0), synthetic(33, 32, 1, 0)), InputError); }
 
 TEST(Flip, BlockMaxFindsTheWorstBlock) {
     FlipResult r;
@@ -251,9 +247,8 @@ TEST(DisplayTransform, AcesThenSrgb) {
 class CompareCommand : public ::testing::Test {
   protected:
     void SetUp() override {
-        dir_ = fs::temp_directory_path() /
-               ("iblcheck_compare_" + std::to_string(::getpid()) + "_" +
-                ::testing::UnitTest::GetInstance()->current_test_info()->name());
+        dir_ = fs::temp_directory_path() / ("iblcheck_compare_" + std::to_string(::getpid()) + "_" +
+                                            ::testing::UnitTest::GetInstance()->current_test_info()->name());
         fs::create_directories(dir_);
     }
     void TearDown() override { fs::remove_all(dir_); }
@@ -316,8 +311,7 @@ TEST_F(CompareCommand, HdrPairOnlyFlipAndHumanTable) {
 TEST_F(CompareCommand, MissingFile) {
     write_png(path("a.png"), synthetic(16, 16, 1, 0));
     EXPECT_EQ(run(args(path("a.png"), path("nope.png"))), kExitError);
-    EXPECT_NE(err_.str().find("error: " + path("nope.png") + ": file not found"), std::string::npos)
-        << err_.str();
+    EXPECT_NE(err_.str().find("error: " + path("nope.png") + ": file not found"), std::string::npos) << err_.str();
 }
 
 TEST_F(CompareCommand, CorruptFile) {
@@ -334,8 +328,7 @@ TEST_F(CompareCommand, SizeMismatch) {
     write_png(path("a.png"), synthetic(16, 16, 1, 0));
     write_png(path("b.png"), synthetic(17, 16, 1, 0));
     EXPECT_EQ(run(args(path("a.png"), path("b.png"))), kExitError);
-    EXPECT_NE(err_.str().find(path("b.png") + ": size 17x16 does not match"), std::string::npos)
-        << err_.str();
+    EXPECT_NE(err_.str().find(path("b.png") + ": size 17x16 does not match"), std::string::npos) << err_.str();
 }
 
 TEST_F(CompareCommand, ChannelMismatch) {
@@ -343,8 +336,7 @@ TEST_F(CompareCommand, ChannelMismatch) {
     cv::Mat grey(16, 16, CV_32F, cv::Scalar(0.5));
     write_png(path("grey.png"), grey);
     EXPECT_EQ(run(args(path("rgb.png"), path("grey.png"))), kExitError);
-    EXPECT_NE(err_.str().find(path("grey.png") + ": has 1 channel(s) but"), std::string::npos)
-        << err_.str();
+    EXPECT_NE(err_.str().find(path("grey.png") + ": has 1 channel(s) but"), std::string::npos) << err_.str();
 }
 
 TEST_F(CompareCommand, NanAndInfPixels) {
@@ -354,8 +346,7 @@ TEST_F(CompareCommand, NanAndInfPixels) {
     write_exr(path("a.exr"), a);
     write_exr(path("b.exr"), b);
     EXPECT_EQ(run(args(path("a.exr"), path("b.exr"))), kExitError);
-    EXPECT_NE(err_.str().find(path("b.exr") + ": 2 non-finite value(s) (NaN/Inf), first at x=7, y=3"),
-              std::string::npos)
+    EXPECT_NE(err_.str().find(path("b.exr") + ": 2 non-finite value(s) (NaN/Inf), first at x=7, y=3"), std::string::npos)
         << err_.str();
 }
 
@@ -390,8 +381,8 @@ TEST_F(CompareCommand, RegisteredSubcommandParsesOptions) {
     CLI::App app("iblcheck");
     int exit_code = -1;
     register_compare_command(app, exit_code);
-    std::vector<std::string> argv = {"compare", path("a.png"), path("b.png"), "--metric", "flip",
-                                     "--ppd", "40", "--json", "--heatmap", path("h.png")};
+    std::vector<std::string> argv = {"compare", path("a.png"), path("b.png"), "--metric",  "flip",
+                                     "--ppd",   "40",          "--json",      "--heatmap", path("h.png")};
     std::reverse(argv.begin(), argv.end()); // CLI11 parses a reversed vector
     testing::internal::CaptureStdout();
     app.parse(argv);
@@ -480,8 +471,8 @@ TEST_F(CompareCommand, PairsReportEveryFailureAndExit2) {
     ASSERT_EQ(lines.size(), 4u) << out_.str();
     EXPECT_EQ(lines[0]["error"], path("nope.png") + ": file not found");
     EXPECT_EQ(lines[1]["error"], "pairs.txt: line 2: expected 2 paths (REF TEST), found 1");
-    EXPECT_NE(lines[2]["error"].get<std::string>().find(path("small.png") + ": size 8x8 does not match"),
-              std::string::npos) << lines[2];
+    EXPECT_NE(lines[2]["error"].get<std::string>().find(path("small.png") + ": size 8x8 does not match"), std::string::npos)
+        << lines[2];
     EXPECT_TRUE(lines[3]["psnr"]["db"].is_null()); // identical: the good pair is still compared
     EXPECT_NE(err_.str().find("compared 1 pair(s), 3 could not be compared"), std::string::npos) << err_.str();
 }
@@ -529,7 +520,7 @@ TEST_F(CompareCommand, RgbaPngColourIsReadAsStoredNotPremultiplied) {
     const LoadedImage la = read_image(path("a.png")), la_rgb = read_image(path("a_rgb.png"));
     EXPECT_EQ(la.file_channels, 4);
     EXPECT_TRUE(la.has_alpha());
-    EXPECT_EQ(cv::norm(la.pixels, la_rgb.pixels, cv::NORM_INF), 0.0);  // not scaled by 0.25
+    EXPECT_EQ(cv::norm(la.pixels, la_rgb.pixels, cv::NORM_INF), 0.0); // not scaled by 0.25
     CompareArgs c = args(path("a.png"), path("b.png"));
     c.json = true;
     ASSERT_EQ(run(c), 0) << err_.str();

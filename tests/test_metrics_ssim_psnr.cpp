@@ -50,8 +50,7 @@ TEST(Ssim, MatchesScikitImageOnGen512) {
     ASSERT_FALSE(ref.hdr);
     const SsimResult s = compute_ssim(ref.pixels, test.pixels);
     const double expected = p["ssim_skimage"].get<double>();
-    std::cout << "[ gen512_ldr ] SSIM " << s.mean << " vs scikit-image " << expected << " (delta "
-              << s.mean - expected << ")\n";
+    std::cout << "[ gen512_ldr ] SSIM " << s.mean << " vs scikit-image " << expected << " (delta " << s.mean - expected << ")\n";
     EXPECT_NEAR(s.mean, expected, 1e-4);
     EXPECT_NEAR(s.mean, (s.per_channel[0] + s.per_channel[1] + s.per_channel[2]) / 3.0, 1e-15);
 }
@@ -64,8 +63,7 @@ TEST(Psnr, MatchesScikitImageOnGen512) {
     const auto test = read_image((kVectors / p["test"].get<std::string>()).string());
     const PsnrResult r = compute_psnr(ref.pixels, test.pixels);
     const double expected = p["psnr_skimage"].get<double>();
-    std::cout << "[ gen512_ldr ] PSNR " << r.db << " dB vs scikit-image " << expected << " (delta "
-              << r.db - expected << ")\n";
+    std::cout << "[ gen512_ldr ] PSNR " << r.db << " dB vs scikit-image " << expected << " (delta " << r.db - expected << ")\n";
     EXPECT_NEAR(r.db, expected, 1e-4);
     EXPECT_NEAR(r.rmse, std::pow(10.0, -expected / 20.0), 1e-6);
 }
@@ -74,7 +72,7 @@ TEST(Ssim, IdenticalIsOneAndNoiseIsLow) {
     const cv::Mat a = noise_image(64, 48, 1), b = noise_image(64, 48, 2);
     EXPECT_DOUBLE_EQ(compute_ssim(a, a).mean, 1.0);
     const double s = compute_ssim(a, b).mean;
-    EXPECT_LT(s, 0.1); // independent noise: no structure in common
+    EXPECT_LT(s, 0.1);                              // independent noise: no structure in common
     EXPECT_NEAR(compute_ssim(b, a).mean, s, 1e-12); // symmetric
 }
 
@@ -100,8 +98,7 @@ TEST(Ssim, ValidRegionNeedsAnElevenPixelWindow) {
 
 TEST(Ssim, HdrUsesTheDisplayTransform) {
     const cv::Mat a = noise_image(40, 30, 4) * 8.0, b = noise_image(40, 30, 5) * 8.0;
-    EXPECT_DOUBLE_EQ(compute_ssim_hdr(a, b).mean,
-                     compute_ssim(display_transform(a), display_transform(b)).mean);
+    EXPECT_DOUBLE_EQ(compute_ssim_hdr(a, b).mean, compute_ssim(display_transform(a), display_transform(b)).mean);
 }
 
 TEST(Psnr, HandComputed) {
@@ -168,9 +165,8 @@ TEST(Temporal, HandComputed) {
 class ImageIo : public ::testing::Test {
   protected:
     void SetUp() override {
-        dir_ = fs::temp_directory_path() /
-               ("iblcheck_io_" + std::to_string(::getpid()) + "_" +
-                ::testing::UnitTest::GetInstance()->current_test_info()->name());
+        dir_ = fs::temp_directory_path() / ("iblcheck_io_" + std::to_string(::getpid()) + "_" +
+                                            ::testing::UnitTest::GetInstance()->current_test_info()->name());
         fs::create_directories(dir_);
     }
     void TearDown() override { fs::remove_all(dir_); }

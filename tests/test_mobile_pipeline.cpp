@@ -13,16 +13,16 @@
 #include <filesystem>
 #include <fstream>
 
-#include "tests/test_support.h"
 #include "metrics/flip.h"
 #include "metrics/image_io.h"
 #include "renderers/environments/environment.h"
 #include "renderers/mobile/gpu_session.h"
 #include "renderers/mobile/ibl_precompute.h"
 #include "renderers/mobile/mobile_renderer.h"
-#include "renderers/sampled/sampled_renderer.h"
 #include "renderers/renderer.h"
+#include "renderers/sampled/sampled_renderer.h"
 #include "renderers/scenes/scene.h"
+#include "tests/test_support.h"
 
 using namespace iblcheck;
 
@@ -120,8 +120,8 @@ ImageDifference difference(const cv::Mat& ref, const cv::Mat& test) {
     return d;
 }
 std::ostream& operator<<(std::ostream& o, const ImageDifference& d) {
-    return o << "FLIP mean " << d.flip_mean << " max " << d.flip_max << ", max abs " << d.max_abs << ", max rel "
-             << d.max_rel << ", differing pixels " << 100 * d.differing << " %";
+    return o << "FLIP mean " << d.flip_mean << " max " << d.flip_max << ", max abs " << d.max_abs << ", max rel " << d.max_rel
+             << ", differing pixels " << 100 * d.differing << " %";
 }
 
 // Emulated against native fp16 on the roughness sweep, measured on this machine (Mesa 22.3,
@@ -143,7 +143,6 @@ void expect_within_fp16_bound(const ImageDifference& d) {
     EXPECT_LT(d.max_rel, kFp16MaxRel) << d;
     EXPECT_LT(d.differing, kFp16Differing) << d;
 }
-
 
 } // namespace
 
@@ -276,11 +275,11 @@ TEST(MobileVariants, EachChangesTheOutputWhereItShouldAndNowhereElse) {
     Scene scene = build_scene(base.scene, base.options);
     struct Case {
         std::string key, value;
-        float max_untouched_roughness;  // spheres with r ≤ this must be bit-identical
+        float max_untouched_roughness; // spheres with r ≤ this must be bit-identical
     };
-    for (const Case& c : {Case{"dominant_dir", "lagarde", 0.0f}, Case{"dominant_dir", "filament", 0.0f},
-                          Case{"mip_mapping", "filament", 0.0f}, Case{"mip_mapping", "origin", 0.0f},
-                          Case{"normalization", "ue4", 0.1f}, Case{"normalization", "directional", 0.1f}}) {
+    for (const Case& c :
+         {Case{"dominant_dir", "lagarde", 0.0f}, Case{"dominant_dir", "filament", 0.0f}, Case{"mip_mapping", "filament", 0.0f},
+          Case{"mip_mapping", "origin", 0.0f}, Case{"normalization", "ue4", 0.1f}, Case{"normalization", "directional", 0.1f}}) {
         TestSpec v = base;
         v.options.set(c.key, c.value);
         cv::Mat img = render(v).image;
@@ -293,15 +292,19 @@ TEST(MobileVariants, EachChangesTheOutputWhereItShouldAndNowhereElse) {
                 bool far_background = p.sphere < 0 && x > 0 && y > 0 && x + 1 < img.cols && y + 1 < img.rows;
                 for (int dy = -1; far_background && dy <= 1; ++dy)
                     for (int dx = -1; dx <= 1; ++dx) far_background &= info[size_t(y + dy) * img.cols + x + dx].sphere < 0;
-                if (far_background) background = std::max(background, d);
-                else if (p.interior) diff[size_t(p.sphere)] = std::max(diff[size_t(p.sphere)], d);
+                if (far_background)
+                    background = std::max(background, d);
+                else if (p.interior)
+                    diff[size_t(p.sphere)] = std::max(diff[size_t(p.sphere)], d);
             }
         EXPECT_EQ(background, 0.0) << c.key << "=" << c.value;
         int changed = 0;
         for (size_t i = 0; i < scene.spheres.size(); ++i) {
             float r = scene.spheres[i].material.roughness;
-            if (r <= c.max_untouched_roughness + 1e-6f) EXPECT_EQ(diff[i], 0.0) << c.key << "=" << c.value << " sphere " << i;
-            else changed += diff[i] > 1e-4;
+            if (r <= c.max_untouched_roughness + 1e-6f)
+                EXPECT_EQ(diff[i], 0.0) << c.key << "=" << c.value << " sphere " << i;
+            else
+                changed += diff[i] > 1e-4;
         }
         EXPECT_GE(changed, 10) << c.key << "=" << c.value;
     }
@@ -314,10 +317,11 @@ TEST(MobileVariants, StorageAndPrecisionChangeTheResultSlightly) {
     // Issue 18's storage values and layouts, measured (relative L1 against RGBA32F): astc_hdr
     // 0.0085, astc_ldr_rgbm 0.171 (rgbm8 0.164: most of it is RGBM's range-6 clip of the lights),
     // octahedral 0.048 (2/3 of the cube's texels), equirect 0.0225.
-    for (auto [k, v, lo, hi] : {std::tuple{"storage", "rgba16f", 1e-6, 0.01}, std::tuple{"storage", "r11g11b10", 1e-5, 0.05},
-                                std::tuple{"storage", "rgbm8", 1e-4, 0.2}, std::tuple{"precision", "mediump", 1e-5, 0.05},
-                                std::tuple{"storage", "astc_hdr", 1e-3, 0.02}, std::tuple{"storage", "astc_ldr_rgbm", 1e-3, 0.25},
-                                std::tuple{"env_layout", "octahedral", 1e-3, 0.08}, std::tuple{"env_layout", "equirect", 1e-3, 0.045}}) {
+    for (auto [k, v, lo, hi] :
+         {std::tuple{"storage", "rgba16f", 1e-6, 0.01}, std::tuple{"storage", "r11g11b10", 1e-5, 0.05},
+          std::tuple{"storage", "rgbm8", 1e-4, 0.2}, std::tuple{"precision", "mediump", 1e-5, 0.05},
+          std::tuple{"storage", "astc_hdr", 1e-3, 0.02}, std::tuple{"storage", "astc_ldr_rgbm", 1e-3, 0.25},
+          std::tuple{"env_layout", "octahedral", 1e-3, 0.08}, std::tuple{"env_layout", "equirect", 1e-3, 0.045}}) {
         TestSpec s = base;
         s.options.set(k, v);
         cv::Mat img = render(s).image;
@@ -349,7 +353,6 @@ RenderResult render_in(GpuSession& gpu, const TestSpec& s) {
     Environment env = load_environment(s.env);
     return s.method == "sampled" ? render_sampled(gpu, env, s) : render_mobile(gpu, env, s);
 }
-
 
 bool identical(const cv::Mat& a, const cv::Mat& b) {
     return a.size() == b.size() && std::memcmp(a.data, b.data, a.total() * a.elemSize()) == 0;
@@ -408,9 +411,9 @@ TEST(MobileCost, CountIsIdenticalOnAnotherCpuClassAndOneThread) {
         double here = render_in(session(), *s).shader_instructions_per_pixel;
         for (std::string env : {"GALLIUM_OVERRIDE_CPU_CAPS=sse4.1", "LP_NUM_THREADS=1"}) {
             std::string out;
-            int rc = run_command(env + " " + std::string(IBLCHECK_BINARY_DIR) + "/iblcheck render --scene roughness_sweep --method " +
-                                     s->method + " --env sky_sun" + (s == &sampled ? " --set samples=64" : "") +
-                                     " --json - 2>/dev/null",
+            int rc = run_command(env + " " + std::string(IBLCHECK_BINARY_DIR) +
+                                     "/iblcheck render --scene roughness_sweep --method " + s->method + " --env sky_sun" +
+                                     (s == &sampled ? " --set samples=64" : "") + " --json - 2>/dev/null",
                                  out, false);
             ASSERT_EQ(rc, 0) << env << ": " << out;
             nlohmann::json j = nlohmann::json::parse(out);
@@ -441,7 +444,7 @@ TEST(MobileCost, ShadingTwiceDoublesTheCountAndARunawayLoopMultipliesIt) {
         std::ofstream(file) << text;
     };
     TestSpec s = spec("roughness_sweep", "sky_sun");
-    TestSpec small = s;  // the runaway loop's image: small, to keep the test quick
+    TestSpec small = s; // the runaway loop's image: small, to keep the test quick
     small.width = 128;
     small.height = 64;
     RenderResult base = render(s), base_small = render(small);
@@ -450,7 +453,7 @@ TEST(MobileCost, ShadingTwiceDoublesTheCountAndARunawayLoopMultipliesIt) {
         setenv("IBLCHECK_SHADER_DIR", (dir / "shaders").c_str(), 1);
         RenderResult r;
         try {
-            GpuSession gpu(vk::ContextOptions{"", true});  // a fresh pipeline cache
+            GpuSession gpu(vk::ContextOptions{"", true}); // a fresh pipeline cache
             r = render_in(gpu, t);
             EXPECT_EQ(gpu.ctx().validation_errors(), 0);
         } catch (...) {
@@ -473,7 +476,7 @@ TEST(MobileCost, ShadingTwiceDoublesTheCountAndARunawayLoopMultipliesIt) {
     double factor = twice.shader_instructions_per_pixel / base.shader_instructions_per_pixel;
     RecordProperty("twice_factor", std::to_string(factor));
     EXPECT_GE(factor, 1.9) << twice.shader_instructions_per_pixel << " vs " << base.shader_instructions_per_pixel;
-    EXPECT_LT(factor, 2.0);  // the per-pixel loop and the store are not doubled
+    EXPECT_LT(factor, 2.0); // the per-pixel loop and the store are not doubled
 
     // A runaway loop in the shading whose result is multiplied by 0 (what issue 14 saw pass).
     std::ofstream(pass) << pass_original;
@@ -501,16 +504,17 @@ TEST(MobileFp16, EmulatedMatchesNativeWithinTheMeasuredBound) {
         EXPECT_FALSE(highp.provenance.contains("fp16"));
         ImageDifference d = difference(native.image, emulated.image);
         std::printf("[ measured ] %s: emulated vs native: FLIP mean %.5f max %.5f, max abs %.4g, max rel %.3g, "
-                    "differing %.1f %%\n", env, d.flip_mean, d.flip_max, d.max_abs, d.max_rel, 100 * d.differing);
+                    "differing %.1f %%\n",
+                    env, d.flip_mean, d.flip_max, d.max_abs, d.max_rel, 100 * d.differing);
         expect_within_fp16_bound(d);
         // Not a no-op: mediump emulated is as far from highp as native mediump is (measured 0.83x
         // in FLIP mean on both environments; a no-op would be ~0).
         ImageDifference dn = difference(highp.image, native.image), de = difference(highp.image, emulated.image);
-        std::printf("[ measured ] %s: highp vs native mediump FLIP mean %.5f, highp vs emulated %.5f\n", env,
-                    dn.flip_mean, de.flip_mean);
+        std::printf("[ measured ] %s: highp vs native mediump FLIP mean %.5f, highp vs emulated %.5f\n", env, dn.flip_mean,
+                    de.flip_mean);
         EXPECT_GT(de.flip_mean, 0.5 * dn.flip_mean) << de;
         EXPECT_LT(de.flip_mean, 1.5 * dn.flip_mean) << de;
-        EXPECT_GT(de.max_rel, 0.01) << de;  // fp16's 2^-11 steps compound well past one ulp somewhere
+        EXPECT_GT(de.max_rel, 0.01) << de; // fp16's 2^-11 steps compound well past one ulp somewhere
     }
     expect_no_validation_errors();
 }
@@ -526,7 +530,8 @@ TEST(MobileFp16, RendersWithoutShaderFloat16InAChildProcess) {
     std::string exr = (dir / "sse41.exr").string(), err = (dir / "stderr.txt").string(), out;
     int rc = run_command("GALLIUM_OVERRIDE_CPU_CAPS=sse4.1 " + bin +
                              " render --scene roughness_sweep --method mobile --env sky_sun --set precision=mediump"
-                             " --out " + exr + " --json - 2>" + err,
+                             " --out " +
+                             exr + " --json - 2>" + err,
                          out, false);
     ASSERT_EQ(rc, 0) << out;
     nlohmann::json j = nlohmann::json::parse(out);
@@ -537,8 +542,8 @@ TEST(MobileFp16, RendersWithoutShaderFloat16InAChildProcess) {
     ASSERT_EQ(native.provenance.value("fp16", ""), session().ctx().info().shader_float16 ? "native" : "emulated");
     ImageDifference d = difference(native.image, read_image(exr).pixels);
     std::printf("[ measured ] sse4.1 emulated vs default-caps %s: FLIP mean %.5f max %.5f, max rel %.3g, differing "
-                "%.1f %%\n", native.provenance.value("fp16", "").c_str(), d.flip_mean, d.flip_max, d.max_rel,
-                100 * d.differing);
+                "%.1f %%\n",
+                native.provenance.value("fp16", "").c_str(), d.flip_mean, d.flip_max, d.max_rel, 100 * d.differing);
     expect_within_fp16_bound(d);
 
     // fp16=native is a clear environment error there, not a crash or a silent fallback.

@@ -11,7 +11,6 @@
 
 #include "metrics/flip.h"
 #include "metrics/image_io.h"
-#include "tests/test_support.h"
 #include "renderers/environments/environment.h"
 #include "renderers/mobile/astc_storage.h"
 #include "renderers/mobile/env_layout.h"
@@ -20,6 +19,7 @@
 #include "renderers/mobile/mobile_renderer.h"
 #include "renderers/renderer.h"
 #include "renderers/scenes/scene.h"
+#include "tests/test_support.h"
 
 using namespace iblcheck;
 
@@ -181,12 +181,12 @@ TEST(StorageLayout, RendersReportTheTexelsAndBytesOfTheirChain) {
         Opts o;
         uint64_t texels, bytes;
     };
-    for (const Case& c : {Case{{}, 6u * 21844, 6u * 21844 * 8},
-                          Case{{{"storage", "astc_hdr"}}, 6u * 21844, 6u * 16 * (1024 + 256 + 64 + 16 + 4 + 1 + 1)},
-                          Case{{{"storage", "astc_ldr_rgbm"}, {"astc_block", "6x6"}}, 6u * 21844,
-                               6u * 16 * (484 + 121 + 36 + 9 + 4 + 1 + 1)},
-                          Case{{{"env_layout", "octahedral"}}, 87376, 87376u * 8},
-                          Case{{{"env_layout", "equirect"}, {"storage", "rgbm8"}}, 2u * 87376, 2u * 87376 * 4}}) {
+    for (const Case& c :
+         {Case{{}, 6u * 21844, 6u * 21844 * 8},
+          Case{{{"storage", "astc_hdr"}}, 6u * 21844, 6u * 16 * (1024 + 256 + 64 + 16 + 4 + 1 + 1)},
+          Case{{{"storage", "astc_ldr_rgbm"}, {"astc_block", "6x6"}}, 6u * 21844, 6u * 16 * (484 + 121 + 36 + 9 + 4 + 1 + 1)},
+          Case{{{"env_layout", "octahedral"}}, 87376, 87376u * 8},
+          Case{{{"env_layout", "equirect"}, {"storage", "rgbm8"}}, 2u * 87376, 2u * 87376 * 4}}) {
         Opts all = c.o;
         all.push_back({"ssaa", "1"});
         RenderResult r = render(spec("sphere", "constant:1", all));
@@ -239,7 +239,7 @@ TEST(StorageLayout, LayoutsMatchTheCubeAndTheirSeamsDoNotShow) {
                     const PixelInfo& p = info[size_t(y) * img.cols + x];
                     if (!p.interior) continue;
                     Dir n{p.normal.x, p.normal.y, p.normal.z};
-                    Dir r{2 * n[2] * n[0], 2 * n[2] * n[1], 2 * n[2] * n[2] - 1};  // reflect(−v, n), v = +Z
+                    Dir r{2 * n[2] * n[0], 2 * n[2] * n[1], 2 * n[2] * n[2] - 1}; // reflect(−v, n), v = +Z
                     Uv uv = l == EnvLayout::octahedral ? octahedral_encode(r) : equirect_encode(r);
                     double to_edge = std::min({uv[0] * inner_w, (1 - uv[0]) * inner_w, uv[1] * inner_h, (1 - uv[1]) * inner_h});
                     cv::Vec3f a = img.at<cv::Vec3f>(y, x), b = cube.at<cv::Vec3f>(y, x);
@@ -251,9 +251,10 @@ TEST(StorageLayout, LayoutsMatchTheCubeAndTheirSeamsDoNotShow) {
             ASSERT_GT(seam_n, 20) << layout << " r=" << rough;
             seam_err /= seam_n;
             rest_err /= rest_n;
-            std::printf("[ seam ] %s r=%s: seam pixels %.3g (n=%g) rest %.3g (n=%g)\n", layout, rough, seam_err, seam_n, rest_err, rest_n);
+            std::printf("[ seam ] %s r=%s: seam pixels %.3g (n=%g) rest %.3g (n=%g)\n", layout, rough, seam_err, seam_n, rest_err,
+                        rest_n);
             EXPECT_LT(seam_err, 1.15 * rest_err + 2e-4) << layout << " r=" << rough;
-            EXPECT_LT(rest_err, 0.03) << layout << " r=" << rough;  // measured at most 0.018
+            EXPECT_LT(rest_err, 0.03) << layout << " r=" << rough; // measured at most 0.018
         }
     }
     expect_no_validation_errors();
@@ -277,7 +278,8 @@ TEST(StorageLayout, DirectionalNormalisationIsNearOneWhereTheLightmapAgreesWithT
         for (size_t i = 0; i < m.size(); ++i) {
             if (scene.spheres[i].material.metallic < 0.5 || scene.spheres[i].material.roughness < 0.3f) continue;
             double dev = std::fabs(m[i] / m_off[i] - 1);
-            (std::string(mode) == "ue4" ? worst_ue4 : worst_dir) = std::max(std::string(mode) == "ue4" ? worst_ue4 : worst_dir, dev);
+            (std::string(mode) == "ue4" ? worst_ue4 : worst_dir) =
+                std::max(std::string(mode) == "ue4" ? worst_ue4 : worst_dir, dev);
         }
     }
     std::printf("[ norm ] sky_sun metals r>=0.3: |scale - 1| ue4 %g, directional %g\n", worst_ue4, worst_dir);
@@ -304,9 +306,9 @@ TEST(StorageLayout, MaterialAoDarkensMetalReflectionsThroughTheNormalisation) {
                        mean({{"metallic", "1"}, {"normalization", norm}});
         double dielectric = mean({{"base_color", "0.5,0.5,0.5"}, {"normalization", norm}}) /
                             mean({{"base_color", "1,1,1"}, {"normalization", norm}});
-        std::printf("[ ao ] %s: metal with AO %g of its unoccluded brightness, dielectric with AO in base colour %g\n",
-                    norm, metal, dielectric);
-        EXPECT_NEAR(metal, ao, 2e-3) << norm;  // the whole reflection scaled by the AO
+        std::printf("[ ao ] %s: metal with AO %g of its unoccluded brightness, dielectric with AO in base colour %g\n", norm,
+                    metal, dielectric);
+        EXPECT_NEAR(metal, ao, 2e-3) << norm; // the whole reflection scaled by the AO
         EXPECT_GT(dielectric, metal + 0.015) << norm;
     }
     // Without a normalisation a metal's AO map does nothing at all: UE4 applies AO to the diffuse
@@ -338,8 +340,9 @@ TEST(StorageLayout, AstcRendersDoNotDependOnWhatTheProcessEncodedFirst) {
                                          "tests": [{"scene": "roughness_sweep", "method": "mobile", "size": "132x24", "variants": )") +
                                            orders[k] + "}]}");
         std::string out;
-        ASSERT_EQ(run_command(std::string(IBLCHECK_BINARY_DIR) + "/iblcheck bless --suite " + (dir / ("order" + std::to_string(k) + ".json")).string() +
-                                  " --goldens " + (dir / ("goldens" + std::to_string(k))).string(),
+        ASSERT_EQ(run_command(std::string(IBLCHECK_BINARY_DIR) + "/iblcheck bless --suite " +
+                                  (dir / ("order" + std::to_string(k) + ".json")).string() + " --goldens " +
+                                  (dir / ("goldens" + std::to_string(k))).string(),
                               out),
                   0)
             << out;

@@ -59,8 +59,8 @@ TEST(OptionTable, GlslNamesAndIndices) {
     EXPECT_EQ(d.at("MIP_MAPPING"), "2");
     EXPECT_EQ(d.at("MIP_MAPPING_UE4"), "0");
     EXPECT_EQ(d.at("MIP_MAPPING_ORIGIN"), "2");
-    EXPECT_EQ(d.at("STORAGE_R11G11B10"), "3");  // named values of every shader option are always there
-    EXPECT_EQ(d.count("STORAGE"), 0u);          // but only the selected options get a selection
+    EXPECT_EQ(d.at("STORAGE_R11G11B10"), "3"); // named values of every shader option are always there
+    EXPECT_EQ(d.count("STORAGE"), 0u);         // but only the selected options get a selection
     EXPECT_EQ(glsl_selection_names({{"storage", "rgbm8"}}).at("STORAGE"), "STORAGE_RGBM8");
 }
 

@@ -56,7 +56,8 @@ double spec_albedo(double mu, double alpha, double f0, int n = 96) {
         double c2 = (1 - xi) / (1 + xi * (a2 - 1));
         double ch = std::sqrt(c2), sh = std::sqrt(std::max(0.0, 1 - c2));
         double phimax;
-        if (sv * sh < 1e-14) phimax = (2 * ch * ch - 1 > 0) ? kPi : 0;
+        if (sv * sh < 1e-14)
+            phimax = (2 * ch * ch - 1 > 0) ? kPi : 0;
         else {
             double c = (mu / (2 * ch) - mu * ch) / (sv * sh);
             phimax = c <= -1 ? kPi : c >= 1 ? 0 : std::acos(c);
@@ -143,8 +144,8 @@ TEST(Quadrature, KnownAlbedos) {
     EXPECT_NEAR(spec_albedo(0.3, 0.5625, 1.0, 96), spec_albedo(0.3, 0.5625, 1.0, 192), 1e-5);
     EXPECT_NEAR(spec_albedo(0.2, 0.0625, 1.0, 96), spec_albedo(0.2, 0.0625, 1.0, 192), 1e-5);
     EXPECT_NEAR(spec_albedo(0.05, 1.0, 0.04, 96), spec_albedo(0.05, 1.0, 0.04, 192), 1e-5);
-    std::printf("E(mu=1): r=0.5 %.6f, r=1 %.6f (1-ln2 = %.6f)\n", spec_albedo(1.0, 0.25, 1.0),
-                spec_albedo(1.0, 1.0, 1.0), 1 - std::log(2.0));
+    std::printf("E(mu=1): r=0.5 %.6f, r=1 %.6f (1-ln2 = %.6f)\n", spec_albedo(1.0, 0.25, 1.0), spec_albedo(1.0, 1.0, 1.0),
+                1 - std::log(2.0));
 }
 
 TEST(EnvDistribution, PdfIntegratesToOneAndMatchesSampling) {
@@ -216,8 +217,7 @@ TEST(EnvDistribution, CellSamplingMatchesPdfAndSolidAngle) {
             inv_sum += dist.cell_mass(c) / p;
         }
         EXPECT_NEAR(inv_sum / n / omega, 1.0, c == sun_cell ? 2e-2 : 2e-3) << "cell " << c;
-        std::printf("cell %d (mass %.4g): E[W_c/pdf] / solid angle = %.5f\n", c, dist.cell_mass(c),
-                    inv_sum / n / omega);
+        std::printf("cell %d (mass %.4g): E[W_c/pdf] / solid angle = %.5f\n", c, dist.cell_mass(c), inv_sum / n / omega);
     }
 }
 
@@ -260,8 +260,8 @@ TEST(ReferenceIntegrator, WindowedEnvSamplingIsUnbiasedAndLessNoisy) {
     d.options.set("env_sampling", "window");
     NoiseFloor nw = measure_noise_floor(d, 128);
     EXPECT_LT(nw.relative_rmse, ng.relative_rmse / 1.6);
-    std::printf("diffuse sphere/studio 64x64, 128 spp: relative RMSE between seeds, global %.4f, window %.4f\n",
-                ng.relative_rmse, nw.relative_rmse);
+    std::printf("diffuse sphere/studio 64x64, 128 spp: relative RMSE between seeds, global %.4f, window %.4f\n", ng.relative_rmse,
+                nw.relative_rmse);
 }
 
 // White furnace, metal F0 = 1: every fully covered pixel equals E(n·v, α) (averaged over the pixel).
@@ -293,8 +293,8 @@ TEST(ReferenceIntegrator, FurnaceMetalMatchesQuadrature) {
             for (int c = 0; c < 3; ++c) {
                 double rel = std::fabs(px[c] / expect - 1);
                 worst[sph] = std::max(worst[sph], rel);
-                ASSERT_LT(rel, 2e-3) << "pixel (" << x << "," << y << ") sphere " << sph << " got " << px[c]
-                                     << " expected " << expect;
+                ASSERT_LT(rel, 2e-3) << "pixel (" << x << "," << y << ") sphere " << sph << " got " << px[c] << " expected "
+                                     << expect;
             }
             ++checked;
         }
@@ -335,8 +335,7 @@ TEST(ReferenceIntegrator, FurnaceDielectricIsLambertPlusSpecular) {
             if (!pixel_mu_grid(s, W, H, x, y, 32, mus, sph)) continue;
             double spec = 0;
             for (double mu : mus)
-                spec += s.spheres[sph].material.roughness == 0 ? model::f_schlick(model::kDielectricF0, mu)
-                                                               : tables[sph](mu);
+                spec += s.spheres[sph].material.roughness == 0 ? model::f_schlick(model::kDielectricF0, mu) : tables[sph](mu);
             spec /= mus.size();
             for (int c = 0; c < 3; ++c) {
                 // 0.3 % (was 0.4 %): environment samples below the horizon make constant-environment renders noisy.
@@ -423,8 +422,7 @@ TEST(ReferenceIntegrator, SmallPatchMatchesAnalyticBrdf) {
                 double hl = std::sqrt(hv[0] * hv[0] + hv[1] * hv[1] + hv[2] * hv[2]);
                 double nh = (n2[0] * hv[0] + n2[1] * hv[1] + n2[2] * hv[2]) / hl;
                 double vh = (v2[0] * hv[0] + v2[1] * hv[1] + v2[2] * hv[2]) / hl;
-                f += model::d_ggx(nh, a) * model::v_smith_ggx_correlated(nv2, nl, a) * model::f_schlick(1.0, vh) *
-                     nl / 16;
+                f += model::d_ggx(nh, a) * model::v_smith_ggx_correlated(nv2, nl, a) * model::f_schlick(1.0, vh) * nl / 16;
             }
         double nl = 1; // folded into f above
         double expect = f * nl * 1000.0 * omega;
@@ -497,8 +495,7 @@ TEST(ReferenceIntegrator, NoiseFloorShrinksWithSpp) {
     EXPECT_GT(lo.relative_rmse, 0);
     EXPECT_GT(lo.covered_pixels, 1000);
     EXPECT_LT(hi.relative_rmse, lo.relative_rmse / 3);
-    std::printf("sphere/studio 48x48 noise floor: spp 16 -> %.4f, spp 256 -> %.4f\n", lo.relative_rmse,
-                hi.relative_rmse);
+    std::printf("sphere/studio 48x48 noise floor: spp 16 -> %.4f, spp 256 -> %.4f\n", lo.relative_rmse, hi.relative_rmse);
 }
 
 // The sub-pixel positions are keyed by pixel_pattern, not by the lighting seed: two seeds cover every
@@ -527,12 +524,13 @@ TEST(ReferenceIntegrator, PixelPatternErrorIsSmall) {
             if ((ca > 0 && ca < 1) || (cc > 0 && cc < 1)) sum_d += std::fabs(ca - cc), ++edge;
         }
     ASSERT_GT(edge, 50);
-    EXPECT_LT(sum_d / edge, 2e-3);        // mean |Δcoverage| of silhouette pixels
+    EXPECT_LT(sum_d / edge, 2e-3);         // mean |Δcoverage| of silhouette pixels
     EXPECT_NEAR(cov_c / cov_a, 1.0, 2e-4); // total covered area
     // The pattern error of the worst case (sharp light edges seen in a mirror) is well below the
     // 0.5 % relative-RMSE criterion the noise floor is held to.
     double rel = relative_rmse(a.result.image, c.result.image, a.coverage);
     EXPECT_LT(rel, 2.5e-3);
     std::printf("pixel pattern 0 vs 1 (2048 positions): mean |dcoverage| on %d silhouette pixels %.5f, area ratio "
-                "%.6f, mirror-sphere relative RMSE %.5f\n", int(edge), sum_d / edge, cov_c / cov_a, rel);
+                "%.6f, mirror-sphere relative RMSE %.5f\n",
+                int(edge), sum_d / edge, cov_c / cov_a, rel);
 }

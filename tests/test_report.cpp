@@ -21,9 +21,9 @@
 
 #include "harness/cli/report_command.h"
 #include "harness/common/errors.h"
-#include "reports/report_writer.h"
 #include "reports/drift.h"
 #include "reports/float_data.h"
+#include "reports/report_writer.h"
 #include "reports/svg_chart.h"
 #include "reports/verdict_text.h"
 #include "tests/report_fixture.h"
@@ -120,7 +120,8 @@ TEST(Report, BlessCommandOnlyWhereNeeded) {
     EXPECT_NE(fail.find("differences may come from the platform"), std::string::npos);
     // The viewer knows the worst block and has its data (test, golden, FLIP map, sphere ids).
     EXPECT_NE(fail.find("data-bx=\"96\" data-by=\"16\""), std::string::npos);
-    for (const char* k : {"data-test=\"", "data-golden=\"", "data-error=\"", "data-ids=\""}) EXPECT_NE(fail.find(k), std::string::npos) << k;
+    for (const char* k : {"data-test=\"", "data-golden=\"", "data-error=\"", "data-ids=\""})
+        EXPECT_NE(fail.find(k), std::string::npos) << k;
     // What failed, in words: the check, where (sphere), the accuracy against the truth before -> after.
     EXPECT_NE(fail.find("baseline: flip.mean 0.0123 &gt; 0.01"), std::string::npos) << fail.substr(0, 3000);
     EXPECT_NE(fail.find("worst 16x16 block at (96,16) on metal r=0.3"), std::string::npos);
@@ -247,10 +248,14 @@ TEST(Report, SelfContainedImagesAndMissingOnes) {
         const json meta = json::parse(js.substr(js.find(',') + 1, js.find("},\"") - js.find(',')));
         const size_t q = js.find(",\"", js.find("},\"")) + 2;
         std::string b64 = js.substr(q, js.rfind('"') - q), bytes;
-        for (size_t i = 0, acc = 0, bits = 0; i < b64.size(); ++i) {  // base64 -> bytes
+        for (size_t i = 0, acc = 0, bits = 0; i < b64.size(); ++i) { // base64 -> bytes
             const char ch = b64[i];
-            const int v = ch >= 'A' && ch <= 'Z' ? ch - 'A' : ch >= 'a' && ch <= 'z' ? ch - 'a' + 26
-                        : ch >= '0' && ch <= '9' ? ch - '0' + 52 : ch == '+' ? 62 : ch == '/' ? 63 : -1;
+            const int v = ch >= 'A' && ch <= 'Z'   ? ch - 'A'
+                          : ch >= 'a' && ch <= 'z' ? ch - 'a' + 26
+                          : ch >= '0' && ch <= '9' ? ch - '0' + 52
+                          : ch == '+'              ? 62
+                          : ch == '/'              ? 63
+                                                   : -1;
             if (v < 0) continue;
             acc = (acc << 6) | size_t(v);
             bits += 6;
@@ -360,9 +365,11 @@ TEST(Report, HistoryFile) {
     // The accuracy's noise floor: --stability's measured floor first, else the truth's seed noise.
     json r = f.results;
     r["tests"][0]["accuracy"]["noise_floor"] = {{"mean_flip", 0.0017}};
-    EXPECT_DOUBLE_EQ(report::history_entry(r)["tests"]["sampled.roughness_sweep.studio.samples=64"]["flip_noise"].get<double>(), 0.0017);
+    EXPECT_DOUBLE_EQ(report::history_entry(r)["tests"]["sampled.roughness_sweep.studio.samples=64"]["flip_noise"].get<double>(),
+                     0.0017);
     r["tests"][0]["stability"] = {{"noise_floor", {{"accuracy.flip.mean", 0.004}}}};
-    EXPECT_DOUBLE_EQ(report::history_entry(r)["tests"]["sampled.roughness_sweep.studio.samples=64"]["flip_noise"].get<double>(), 0.004);
+    EXPECT_DOUBLE_EQ(report::history_entry(r)["tests"]["sampled.roughness_sweep.studio.samples=64"]["flip_noise"].get<double>(),
+                     0.004);
     EXPECT_EQ(e.dump().find('\n'), std::string::npos);
 
     const fs::path bad = f.root / "bad_history.jsonl";
@@ -381,8 +388,7 @@ TEST(Report, ReportCommandRebuildsFromStoredResults) {
     CLI::App app;
     int exit_code = -1;
     cli::register_report_command(app, exit_code);
-    const std::string res = (f.results_dir / "results.json").string(), o = out.string(),
-                      h = (f.root / "history.jsonl").string();
+    const std::string res = (f.results_dir / "results.json").string(), o = out.string(), h = (f.root / "history.jsonl").string();
     std::vector<std::string> args{h, "--history", o, "--out", res, "report"}; // CLI11 wants them reversed
     app.parse(args);
     EXPECT_EQ(exit_code, 0);
@@ -390,7 +396,6 @@ TEST(Report, ReportCommandRebuildsFromStoredResults) {
     EXPECT_NE(html.find("data-chart=\"history-flip_mean\""), std::string::npos);
     EXPECT_TRUE(fs::exists(out / "images/t2/test.png"));
 }
-
 
 // ---- what the history flags (drift.h) ----
 

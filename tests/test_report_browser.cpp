@@ -110,8 +110,10 @@ TEST(ReportBrowser, CiReportWithOneFailureReadsInTheFirstScreenAndItsViewerWorks
         };
         EXPECT_LE(bottom(card + " .cmd.bless"), 900);
         EXPECT_LE(bottom(card + " input.ev"), 900);
-        EXPECT_LE(b.eval("document.querySelector('" + card + " canvas.cv-img').getBoundingClientRect().top").get<double>() + 100, 900);
-        const int zoom = std::stoi(b.eval("document.querySelector('" + card + " .viewer').getAttribute('data-zoom')").get<std::string>());
+        EXPECT_LE(b.eval("document.querySelector('" + card + " canvas.cv-img').getBoundingClientRect().top").get<double>() + 100,
+                  900);
+        const int zoom =
+            std::stoi(b.eval("document.querySelector('" + card + " .viewer').getAttribute('data-zoom')").get<std::string>());
         EXPECT_GE(zoom, 2);
         EXPECT_EQ(b.eval("document.querySelector('" + card + " canvas.cv-img').style.width").get<std::string>(),
                   std::to_string(run.width * zoom) + "px");
@@ -119,14 +121,15 @@ TEST(ReportBrowser, CiReportWithOneFailureReadsInTheFirstScreenAndItsViewerWorks
         // Exposure 0 is the harness's display transform of the float data (the PNG, without its banding).
         auto pixel = [&](int x, int y) {
             return b.eval(fmt::format("Array.from(document.querySelector('{} canvas.cv-img').getContext('2d')"
-                                      ".getImageData({},{},1,1).data)", card, x, y));
+                                      ".getImageData({},{},1,1).data)",
+                                      card, x, y));
         };
         auto click = [&](const std::string& sel) {
             auto [x, y] = b.centre_of(sel);
             b.click(x, y);
         };
         click(card + " button.ev-0");
-        const int px = 24 + 48 * 2, py = 24;  // metal r=0.2, its centre
+        const int px = 24 + 48 * 2, py = 24; // metal r=0.2, its centre
         json p0 = pixel(px, py);
         const cv::Vec3f lin = run.failing_test.at<cv::Vec3f>(py, px);
         for (int c = 0; c < 3; ++c)
@@ -134,7 +137,7 @@ TEST(ReportBrowser, CiReportWithOneFailureReadsInTheFirstScreenAndItsViewerWorks
         // The slider, moved by the mouse: +EV brightens the same pixel; the readout says so.
         auto [sx, sy] = b.centre_of(card + " input.ev");
         const double sw = b.eval("document.querySelector('" + card + " input.ev').getBoundingClientRect().width").get<double>();
-        b.click(sx + 0.25 * sw, sy);  // from its centre: -12..+12 EV, so about +6 EV
+        b.click(sx + 0.25 * sw, sy); // from its centre: -12..+12 EV, so about +6 EV
         const std::string ev = b.eval("document.querySelector('" + card + " output.evv').textContent").get<std::string>();
         EXPECT_EQ(ev.rfind("+", 0), 0u) << ev;
         json p1 = pixel(px, py);
@@ -148,34 +151,38 @@ TEST(ReportBrowser, CiReportWithOneFailureReadsInTheFirstScreenAndItsViewerWorks
         click(card + " button.z[data-z='4']");
         EXPECT_EQ(b.eval("document.querySelector('" + card + " canvas.cv-img').style.width").get<std::string>(),
                   std::to_string(run.width * 4) + "px");
-        EXPECT_EQ(b.eval("getComputedStyle(document.querySelector('" + card + " canvas.cv-img')).imageRendering").get<std::string>(),
-                  "pixelated");
+        EXPECT_EQ(
+            b.eval("getComputedStyle(document.querySelector('" + card + " canvas.cv-img')).imageRendering").get<std::string>(),
+            "pixelated");
         EXPECT_EQ(b.eval("document.querySelector('" + card + " .vimg .blk').style.left").get<std::string>(), "960px");
 
         // The pointer names the sphere under it and the magnifier follows it.
         const json r = b.eval("(function(){var c=document.querySelector('" + card +
                               " canvas.cv-img');c.scrollIntoView({block:'center'});var b=c.getBoundingClientRect();"
                               "return [b.left,b.top];})()");
-        const int hx = 24 + 48 * 3, hy = 20;  // metal r=0.3
+        const int hx = 24 + 48 * 3, hy = 20; // metal r=0.3
         b.mouse_move(r[0].get<double>() + (hx + 0.5) * 4, r[1].get<double>() + (hy + 0.5) * 4);
         const std::string readout = b.eval("document.querySelector('" + card + " .readout').textContent").get<std::string>();
         EXPECT_EQ(readout.rfind(fmt::format("({},{}) metal r=0.3 \u00b7 roughness 0.3, metallic 1", hx, hy), 0), 0u) << readout;
         EXPECT_EQ(b.eval("document.querySelector('" + card + " .vimg .ptr').textContent").get<std::string>(), "metal r=0.3");
-        EXPECT_NE(b.eval("document.querySelector('" + card + " .mcap').textContent").get<std::string>().find(
-                      fmt::format("around ({},{}) on metal r=0.3", hx, hy)),
+        EXPECT_NE(b.eval("document.querySelector('" + card + " .mcap').textContent")
+                      .get<std::string>()
+                      .find(fmt::format("around ({},{}) on metal r=0.3", hx, hy)),
                   std::string::npos);
         const json mg = b.eval("Array.from(document.querySelector('" + card +
                                " canvas.mg-t').getContext('2d').getImageData(72,72,1,1).data)");
         EXPECT_GT(mg[0].get<int>() + mg[1].get<int>() + mg[2].get<int>(), 30) << "the magnifier drew the sphere";
 
         // The heatmap's colour bar has its scale; the mask counts the pixels over the tolerance.
-        EXPECT_EQ(b.eval("Array.from(document.querySelectorAll('" + card + " .cbar .tk')).pop().textContent").get<std::string>(), "0.5");
+        EXPECT_EQ(b.eval("Array.from(document.querySelectorAll('" + card + " .cbar .tk')).pop().textContent").get<std::string>(),
+                  "0.5");
         click(card + " input.mask");
         const std::string mask = b.eval("document.querySelector('" + card + " .maskinfo').textContent").get<std::string>();
         EXPECT_EQ(mask.rfind(std::to_string(run.pixels_over_002) + " px (", 0), 0u) << mask;
         EXPECT_GT(run.pixels_over_002, 500);
         const json masked = b.eval(fmt::format("Array.from(document.querySelector('{} canvas.cv-err').getContext('2d')"
-                                               ".getImageData({},{},1,1).data)", card, 24 + 48 * 5, 24));
+                                               ".getImageData({},{},1,1).data)",
+                                               card, 24 + 48 * 5, 24));
         EXPECT_EQ(masked, json({0, 229, 255, 255})) << "a pixel over the tolerance is drawn in the mask colour";
 
         // A passing test's tile opens its card, whose viewer then draws.

@@ -275,9 +275,8 @@ TEST(Scene, MaterialOptions) {
     OptionMap bad;
     bad.set("roughness", "1.5");
     EXPECT_THROW(build_scene("sphere", bad), UsageError);
-    EXPECT_EQ(scene_option_keys(), (std::vector<std::string>{"roughness", "metallic", "base_color", "frame",
-                                                              "bump_amplitude", "bump_frequency", "roughness_bias",
-                                                              "camera_shift", "ao"}));
+    EXPECT_EQ(scene_option_keys(), (std::vector<std::string>{"roughness", "metallic", "base_color", "frame", "bump_amplitude",
+                                                             "bump_frequency", "roughness_bias", "camera_shift", "ao"}));
     // ao reaches every sphere of any scene, and is checked like the other material options.
     OptionMap occluded;
     occluded.set("ao", "0.25");

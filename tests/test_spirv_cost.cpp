@@ -52,9 +52,8 @@ vk::CompiledShader compile(const std::string& name, const std::string& source) {
 std::string validate(const std::vector<uint32_t>& spirv) {
     spvtools::SpirvTools tools(SPV_ENV_VULKAN_1_2);
     std::string messages;
-    tools.SetMessageConsumer([&](spv_message_level_t, const char*, const spv_position_t&, const char* m) {
-        messages += std::string(m) + "\n";
-    });
+    tools.SetMessageConsumer(
+        [&](spv_message_level_t, const char*, const spv_position_t&, const char* m) { messages += std::string(m) + "\n"; });
     return tools.Validate(spirv) ? "" : "invalid: " + messages;
 }
 
@@ -118,8 +117,8 @@ Run run(const std::vector<uint32_t>& spirv, bool counted, std::vector<uint32_t> 
 }
 
 // Instruments, validates, and checks that the instrumented module writes what the original does.
-std::vector<uint32_t> instrument_checked(const vk::CompiledShader& original, const std::vector<uint32_t>& data,
-                                         uint32_t push, uint32_t groups = 1) {
+std::vector<uint32_t> instrument_checked(const vk::CompiledShader& original, const std::vector<uint32_t>& data, uint32_t push,
+                                         uint32_t groups = 1) {
     std::vector<uint32_t> counted = vk::instrument_instruction_count(original.spirv);
     EXPECT_EQ(validate(original.spirv), "");
     EXPECT_EQ(validate(counted), "");
@@ -155,10 +154,10 @@ TEST(SpirvCost, LoopCountGrowsExactlyLinearlyWithTheBodysStaticCount) {
     ASSERT_EQ(blocks.size(), 1u);
     ASSERT_EQ(blocks[0].size(), 6u);
     const auto& b = blocks[0];
-    const uint64_t slope = b[1] + b[2] + b[3] + b[4];  // one more trip: header + condition + body + continue
-    const uint64_t base = b[0] + b[1] + b[2] + b[5];   // no trip: entry, the failing test, merge
-    EXPECT_EQ(slope, 19u);  // this glslang's output: 2 + 6 + 7 + 4 (the disassembly, by hand)
-    EXPECT_EQ(base, 22u);   // 9 + 2 + 6 + 5
+    const uint64_t slope = b[1] + b[2] + b[3] + b[4]; // one more trip: header + condition + body + continue
+    const uint64_t base = b[0] + b[1] + b[2] + b[5];  // no trip: entry, the failing test, merge
+    EXPECT_EQ(slope, 19u);                            // this glslang's output: 2 + 6 + 7 + 4 (the disassembly, by hand)
+    EXPECT_EQ(base, 22u);                             // 9 + 2 + 6 + 5
 
     std::vector<uint32_t> data(128, 0);
     auto counted = instrument_checked(s, data, 0);
@@ -236,14 +235,14 @@ void main() {
 )");
     auto blocks = disassembled_block_sizes(s.spirv);
     ASSERT_EQ(blocks.size(), 1u);
-    ASSERT_EQ(blocks[0].size(), 4u);  // entry, then, else, merge
+    ASSERT_EQ(blocks[0].size(), 4u); // entry, then, else, merge
     const auto& b = blocks[0];
     const uint64_t then_path = b[0] + b[1] + b[3], else_path = b[0] + b[2] + b[3];
     ASSERT_NE(then_path, else_path);
     std::vector<uint32_t> data(128, 0);
     std::iota(data.begin(), data.begin() + 64, 0u);
     auto counted = instrument_checked(s, data, 5);
-    EXPECT_EQ(run(counted, true, data, 100).count, 64 * else_path);        // nobody above 100
+    EXPECT_EQ(run(counted, true, data, 100).count, 64 * else_path);           // nobody above 100
     EXPECT_EQ(run(counted, true, data, 0).count, 63 * then_path + else_path); // all but n = 0
     EXPECT_EQ(run(counted, true, data, 5).count, 58 * then_path + 6 * else_path);
 }
@@ -263,7 +262,7 @@ void main() {
 )");
     auto blocks = disassembled_block_sizes(s.spirv);
     ASSERT_EQ(blocks.size(), 1u);
-    ASSERT_EQ(blocks[0].size(), 3u);  // entry, the return, the rest
+    ASSERT_EQ(blocks[0].size(), 3u); // entry, the return, the rest
     const auto& b = blocks[0];
     const uint64_t early = b[0] + b[1], late = b[0] + b[2];
     ASSERT_LT(early, late);
@@ -286,7 +285,7 @@ void main() {
 }
 )");
     auto blocks = disassembled_block_sizes(s.spirv);
-    ASSERT_EQ(blocks.size(), 2u);  // main, then the function
+    ASSERT_EQ(blocks.size(), 2u); // main, then the function
     ASSERT_EQ(blocks[0].size(), 6u);
     ASSERT_EQ(blocks[1].size(), 1u);
     const auto& m = blocks[0];

@@ -24,7 +24,8 @@ using namespace iblcheck;
 namespace {
 class SuiteTest : public testing::Test {
   public:
-    SuiteTest(std::string name, bool in_shard, std::string shard) : name_(std::move(name)), in_shard_(in_shard), shard_(std::move(shard)) {}
+    SuiteTest(std::string name, bool in_shard, std::string shard)
+        : name_(std::move(name)), in_shard_(in_shard), shard_(std::move(shard)) {}
     void TestBody() override {
         if (!in_shard_) GTEST_SKIP() << name_ << " runs in another shard (this is shard " << shard_ << ")";
         RunOptions o;

@@ -15,8 +15,7 @@ namespace iblcheck::testutil {
 
 // An empty folder under the system temp folder, unique to this process: <tmp>/iblcheck_<name>_<pid>.
 inline std::filesystem::path temp_dir(const std::string& name) {
-    std::filesystem::path p =
-        std::filesystem::temp_directory_path() / ("iblcheck_" + name + "_" + std::to_string(::getpid()));
+    std::filesystem::path p = std::filesystem::temp_directory_path() / ("iblcheck_" + name + "_" + std::to_string(::getpid()));
     std::filesystem::remove_all(p);
     std::filesystem::create_directories(p);
     return p;

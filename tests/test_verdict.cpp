@@ -32,7 +32,7 @@ TEST(Verdict, NamesRoundTripAndOrderBySeverity) {
     EXPECT_EQ(overall_verdict({Verdict::missing_golden, Verdict::error}), Verdict::error);
     EXPECT_TRUE(is_regression(Verdict::fail));
     EXPECT_TRUE(is_regression(Verdict::missing_golden));
-    EXPECT_FALSE(is_regression(Verdict::error));  // "cannot test": exit 2, bisect 125
+    EXPECT_FALSE(is_regression(Verdict::error)); // "cannot test": exit 2, bisect 125
     EXPECT_FALSE(is_regression(Verdict::improved));
 }
 
@@ -52,15 +52,15 @@ TEST(Verdict, BoundEdgesAreInclusiveAndMessagesSayByHowMuch) {
 TEST(Verdict, NanNeverPasses) {
     EXPECT_EQ(judge_bound("ssim.mean", kNaN, Bound{0.999, std::nullopt}).status, Verdict::fail);
     EXPECT_EQ(judge_bound("flip.mean", kNaN, Bound{std::nullopt, 1.0}).status, Verdict::fail);
-    EXPECT_EQ(judge_bound("flip.mean", 0.0, Bound{std::nullopt, kNaN}).status, Verdict::fail);  // a NaN bound
+    EXPECT_EQ(judge_bound("flip.mean", 0.0, Bound{std::nullopt, kNaN}).status, Verdict::fail); // a NaN bound
     EXPECT_EQ(judge_bound("ssim.mean", 1.0, Bound{kNaN, std::nullopt}).status, Verdict::fail);
     EXPECT_EQ(judge_band("flip.mean", kNaN, 0.1, Band{}).status, Verdict::fail);
     EXPECT_EQ(judge_band("flip.mean", 0.1, kNaN, Band{}).status, Verdict::fail);
     EXPECT_EQ(judge_cost("cost.x", kNaN, 100, 0.25).status, Verdict::fail);
     EXPECT_EQ(judge_cost("cost.x", 100, kNaN, 0.25).status, Verdict::fail);
     // A golden whose SSIM came out NaN: the baseline comparison fails (it used to pass).
-    Comparison c = judge_baseline(flip_metrics(0.0, kNaN), {{"ssim.mean", Bound{0.999, std::nullopt}},
-                                                            {"flip.mean", Bound{std::nullopt, 0.001}}});
+    Comparison c = judge_baseline(flip_metrics(0.0, kNaN),
+                                  {{"ssim.mean", Bound{0.999, std::nullopt}}, {"flip.mean", Bound{std::nullopt, 0.001}}});
     EXPECT_EQ(c.verdict, Verdict::fail);
     EXPECT_NE(c.message.find("ssim.mean is NaN"), std::string::npos) << c.message;
     // A metric the comparison does not have reads as NaN, so its tolerance fails.
@@ -70,7 +70,7 @@ TEST(Verdict, NanNeverPasses) {
 }
 
 TEST(Verdict, ReferenceBandFailsOnTheWorseSideAndImprovesOnTheBetter) {
-    Band band{0.2, 0.1, 0.002};  // [0.1·0.8 − 0.002, 0.1·1.1 + 0.002] = [0.078, 0.112]
+    Band band{0.2, 0.1, 0.002}; // [0.1·0.8 − 0.002, 0.1·1.1 + 0.002] = [0.078, 0.112]
     EXPECT_EQ(judge_band("accuracy.flip.mean", 0.112, 0.1, band).status, Verdict::pass);
     EXPECT_EQ(judge_band("accuracy.flip.mean", 0.0781, 0.1, band).status, Verdict::pass);
     Check worse = judge_band("accuracy.flip.mean", 0.113, 0.1, band);
@@ -107,10 +107,10 @@ TEST(Verdict, AnyOfSeveralBaselinesPassesElseTheClosestIsReported) {
     std::map<std::string, Bound> tol = {{"flip.mean", Bound{std::nullopt, 0.001}}};
     std::vector<Comparison> c = {judge_baseline(flip_metrics(0.05), tol), judge_baseline(flip_metrics(0.0005), tol),
                                  judge_baseline(flip_metrics(0.0), tol)};
-    EXPECT_EQ(choose_baseline(c), 1u);  // the first that passes
+    EXPECT_EQ(choose_baseline(c), 1u); // the first that passes
     std::vector<Comparison> failing = {judge_baseline(flip_metrics(0.05), tol), judge_baseline(flip_metrics(0.02), tol),
                                        judge_size("baseline", 8, 8, 16, 16)};
-    EXPECT_EQ(choose_baseline(failing), 1u);  // the closest failing one
+    EXPECT_EQ(choose_baseline(failing), 1u); // the closest failing one
     Comparison size = judge_size("baseline", 528, 96, 256, 96);
     EXPECT_EQ(size.verdict, Verdict::fail);
     EXPECT_EQ(size.message, "size 528x96 but the baseline golden is 256x96");
@@ -130,5 +130,5 @@ TEST(Verdict, JsonHasTheResultsFormatKeys) {
     json jc = to_json(cmp);
     EXPECT_EQ(jc["kind"], "reference");
     EXPECT_EQ(jc["verdict"], "fail");
-    EXPECT_TRUE(jc["checks"][0]["value"].is_number());  // the report's schema wants numbers
+    EXPECT_TRUE(jc["checks"][0]["value"].is_number()); // the report's schema wants numbers
 }

@@ -10,11 +10,11 @@
 #include <fstream>
 #include <sys/wait.h>
 
-#include "tests/test_support.h"
 #include "harness/common/errors.h"
 #include "renderers/option_table.h"
 #include "renderers/vulkan/context.h"
 #include "renderers/vulkan/fp16_emulation.h"
+#include "tests/test_support.h"
 
 namespace fs = std::filesystem;
 using namespace iblcheck;
@@ -22,8 +22,6 @@ using namespace iblcheck;
 namespace {
 
 using namespace iblcheck::testutil;
-
-
 
 // Runs a shell command, returns its exit status and output (stdout + stderr).
 
@@ -156,27 +154,26 @@ TEST(Doctor, StatesTheFp16DecisionTheRendererMakes) {
     // llvmpipe targets a CPU without AVX (no F16C, no shaderFloat16). Before issue 15 doctor
     // claimed an fp32 fallback while the renderer refused the variant.
     vk::Context ctx({"", false});
-    std::string expected = "precision=mediump: " + vk::fp16_path_description(vk::choose_fp16_path(
-                                                       "auto", ctx.info().shader_float16, ctx.info().device_name));
+    std::string expected =
+        "precision=mediump: " +
+        vk::fp16_path_description(vk::choose_fp16_path("auto", ctx.info().shader_float16, ctx.info().device_name));
     std::string out;
     EXPECT_EQ(run_command(std::string(IBLCHECK_BINARY_DIR) + "/iblcheck doctor", out), 0) << out;
     EXPECT_NE(out.find(expected + "\n"), std::string::npos) << out;
     EXPECT_NE(out.find("precision=mediump: native float16_t\n"), std::string::npos) << out;
     EXPECT_NE(out.find("llvmpipe cpu:    "), std::string::npos) << out;
-    EXPECT_EQ(run_command("GALLIUM_OVERRIDE_CPU_CAPS=sse4.1 " + std::string(IBLCHECK_BINARY_DIR) + "/iblcheck doctor", out),
-              0)
+    EXPECT_EQ(run_command("GALLIUM_OVERRIDE_CPU_CAPS=sse4.1 " + std::string(IBLCHECK_BINARY_DIR) + "/iblcheck doctor", out), 0)
         << out;
     EXPECT_NE(out.find("shaderFloat16:   no\n"), std::string::npos) << out;
-    EXPECT_NE(out.find("precision=mediump: " + vk::fp16_path_description(vk::Fp16Path::emulated) + "\n"),
-              std::string::npos)
+    EXPECT_NE(out.find("precision=mediump: " + vk::fp16_path_description(vk::Fp16Path::emulated) + "\n"), std::string::npos)
         << out;
     EXPECT_NE(out.find("cpu override:    GALLIUM_OVERRIDE_CPU_CAPS=sse4.1"), std::string::npos) << out;
 }
 
 TEST(Doctor, WithoutDriverExitsTwoWithAFix) {
     std::string out;
-    int rc = run_command("VK_ICD_FILENAMES=/nonexistent VK_DRIVER_FILES=/nonexistent " +
-                             std::string(IBLCHECK_BINARY_DIR) + "/iblcheck doctor",
+    int rc = run_command("VK_ICD_FILENAMES=/nonexistent VK_DRIVER_FILES=/nonexistent " + std::string(IBLCHECK_BINARY_DIR) +
+                             "/iblcheck doctor",
                          out);
     EXPECT_EQ(rc, 2) << out;
     EXPECT_NE(out.find("no Vulkan driver found"), std::string::npos) << out;
@@ -188,10 +185,10 @@ TEST(Cli, ShaderCompileErrorExitsTwoWithFileLine) {
     fs::copy(fs::path(IBLCHECK_SOURCE_DIR) / "renderers/shaders", dir / "shaders", fs::copy_options::recursive);
     std::ofstream(dir / "shaders/env_brdf.glsl", std::ios::app) << "\nthis is not glsl;\n";
     std::string out;
-    int rc = run_command("IBLCHECK_SHADER_DIR=" + (dir / "shaders").string() + " IBLCHECK_CACHE_DIR=" + dir.string() +
-                             " " + std::string(IBLCHECK_BINARY_DIR) +
-                             "/iblcheck render --scene sphere --env constant:1 --method mobile",
-                         out);
+    int rc =
+        run_command("IBLCHECK_SHADER_DIR=" + (dir / "shaders").string() + " IBLCHECK_CACHE_DIR=" + dir.string() + " " +
+                        std::string(IBLCHECK_BINARY_DIR) + "/iblcheck render --scene sphere --env constant:1 --method mobile",
+                    out);
     EXPECT_EQ(rc, 2) << out;
     EXPECT_NE(out.find("env_brdf.glsl:"), std::string::npos) << out;
     fs::remove_all(dir);

@@ -4,9 +4,9 @@
 #include <cmath>
 #include <fstream>
 #include <iostream>
+#include <memory>
 #include <sstream>
 #include <vector>
-#include <memory>
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
@@ -68,17 +68,17 @@ PairResult compare_pair(const CompareArgs& a) {
     // refuse. (Alpha itself is not scored: both files' colour is read as stored.)
     const int ch_ref = ref.file_channels <= 2 ? 1 : 3, ch_test = test.file_channels <= 2 ? 1 : 3;
     if (ch_ref != ch_test || ref.has_alpha() != test.has_alpha())
-        throw InputError(fmt::format("{}: has {} channel(s) but {} has {}", a.test,
-                                     test.file_channels, a.reference, ref.file_channels));
+        throw InputError(
+            fmt::format("{}: has {} channel(s) but {} has {}", a.test, test.file_channels, a.reference, ref.file_channels));
     if (ref.hdr != test.hdr)
-        throw InputError(fmt::format("{}: is {} but {} is {}", a.test, test.hdr ? "HDR" : "LDR",
-                                     a.reference, ref.hdr ? "HDR" : "LDR"));
+        throw InputError(
+            fmt::format("{}: is {} but {} is {}", a.test, test.hdr ? "HDR" : "LDR", a.reference, ref.hdr ? "HDR" : "LDR"));
     // The FLIP tool scores +Inf pixels as 0 error; a NaN/Inf is a renderer bug, not a score.
     check_finite(ref.pixels, a.reference);
     check_finite(test.pixels, a.test);
 
-    const bool hdr = a.mode == "hdr" || (a.mode == "auto" && (ref.hdr || lower_ext(a.reference) == "exr" ||
-                                                             lower_ext(a.reference) == "hdr"));
+    const bool hdr =
+        a.mode == "hdr" || (a.mode == "auto" && (ref.hdr || lower_ext(a.reference) == "exr" || lower_ext(a.reference) == "hdr"));
     res.hdr = hdr;
     size_t* clamped = res.clamped;
     if (hdr) {
@@ -87,9 +87,9 @@ PairResult compare_pair(const CompareArgs& a) {
             const size_t neg = count_negative(imgs[i]->pixels);
             if (neg == 0) continue;
             if (!a.clamp_negative)
-                throw InputError(fmt::format(
-                    "{}: {} negative value(s) in HDR input (radiance must be >= 0; "
-                    "use --clamp-negative to clamp them to 0)", imgs[i]->path, neg));
+                throw InputError(fmt::format("{}: {} negative value(s) in HDR input (radiance must be >= 0; "
+                                             "use --clamp-negative to clamp them to 0)",
+                                             imgs[i]->path, neg));
             clamped[i] = clamp_negative(imgs[i]->pixels);
         }
     }
@@ -101,8 +101,7 @@ PairResult compare_pair(const CompareArgs& a) {
         fo.start_exposure = a.start_exposure;
         fo.stop_exposure = a.stop_exposure;
         fo.threads = a.threads;
-        fr = hdr ? compute_flip_hdr(ref.pixels, test.pixels, fo)
-                 : compute_flip_ldr(ref.pixels, test.pixels, fo);
+        fr = hdr ? compute_flip_hdr(ref.pixels, test.pixels, fo) : compute_flip_ldr(ref.pixels, test.pixels, fo);
         // The shared keys (metrics/flip_json.h), plus what only a command-line comparison chooses.
         nlohmann::json f = flip_json(fr);
         f["ppd"] = fr.ppd;
@@ -113,11 +112,10 @@ PairResult compare_pair(const CompareArgs& a) {
     }
     if (want_ssim && !ssim_applicable(ref.pixels)) {
         j["ssim"] = {{"mean", nullptr},
-                     {"not_applicable", fmt::format("{}x{} is smaller than SSIM's {}x{} window", ref.pixels.cols,
-                                                    ref.pixels.rows, kSsimMinSize, kSsimMinSize)}};
+                     {"not_applicable", fmt::format("{}x{} is smaller than SSIM's {}x{} window", ref.pixels.cols, ref.pixels.rows,
+                                                    kSsimMinSize, kSsimMinSize)}};
     } else if (want_ssim) {
-        const SsimResult s = hdr ? compute_ssim_hdr(ref.pixels, test.pixels)
-                                 : compute_ssim(ref.pixels, test.pixels);
+        const SsimResult s = hdr ? compute_ssim_hdr(ref.pixels, test.pixels) : compute_ssim(ref.pixels, test.pixels);
         j["ssim"] = {{"mean", s.mean}};
     }
     if (want_psnr) {
@@ -125,8 +123,7 @@ PairResult compare_pair(const CompareArgs& a) {
         j["psnr"] = {{"db", num(p.db)}, {"rmse", p.rmse}, {"max_abs", p.max_abs}};
         if (hdr) j["psnr"]["relative_mse"] = compute_relative_mse(ref.pixels, test.pixels);
     }
-    if (clamped[0] || clamped[1])
-        j["clamped_negative"] = {{"reference", clamped[0]}, {"test", clamped[1]}};
+    if (clamped[0] || clamped[1]) j["clamped_negative"] = {{"reference", clamped[0]}, {"test", clamped[1]}};
     return res;
 }
 
@@ -144,20 +141,18 @@ int run_compare(const CompareArgs& a, std::ostream& out, std::ostream& err) {
         if (a.json) {
             out << j.dump(2) << "\n";
         } else {
-            out << fmt::format("reference: {}\ntest:      {}\nmode:      {}\n", a.reference, a.test,
-                               hdr ? "hdr" : "ldr");
+            out << fmt::format("reference: {}\ntest:      {}\nmode:      {}\n", a.reference, a.test, hdr ? "hdr" : "ldr");
             if (clamped[0] || clamped[1])
                 out << fmt::format("clamped negative values: reference {}, test {}\n", clamped[0], clamped[1]);
             if (want_flip) {
                 out << fmt::format("FLIP mean {:.6f}  weighted median {:.6f}  (q1 {:.6f}, q3 {:.6f})  "
                                    "p99 {:.6f}  max {:.6f}\n",
                                    fr.mean, fr.weighted_median, fr.weighted_q1, fr.weighted_q3, fr.p99, fr.max);
-                out << fmt::format("FLIP worst 16x16 block: mean {:.6f} at x={}, y={}\n", fr.block_max,
-                                   fr.block_x, fr.block_y);
+                out << fmt::format("FLIP worst 16x16 block: mean {:.6f} at x={}, y={}\n", fr.block_max, fr.block_x, fr.block_y);
                 if (hdr)
                     out << fmt::format("HDR-FLIP exposures: {:.4f} to {:.4f}, {} exposures ({}), range from {}\n",
-                                       fr.start_exposure, fr.stop_exposure, fr.num_exposures,
-                                       flip::tone_mapper_name(tm), fr.exposure_source);
+                                       fr.start_exposure, fr.stop_exposure, fr.num_exposures, flip::tone_mapper_name(tm),
+                                       fr.exposure_source);
             }
             if (want_ssim)
                 out << (j["ssim"]["mean"].is_null()
@@ -230,8 +225,8 @@ int run_compare_pairs(const CompareArgs& a, std::istream& list, const std::strin
         if (p.kind == PairLine::Kind::blank) continue;
         nlohmann::json j;
         if (p.kind == PairLine::Kind::bad) {
-            j = {{"list", list_name}, {"line", line_no},
-                 {"error", fmt::format("{}: line {}: {}", list_name, line_no, p.problem)}};
+            j = {
+                {"list", list_name}, {"line", line_no}, {"error", fmt::format("{}: line {}: {}", list_name, line_no, p.problem)}};
         } else {
             CompareArgs one = a;
             one.reference = p.reference;
@@ -272,10 +267,8 @@ void register_compare_command(CLI::App& app, int& exit_code) {
     sub->add_option("--pairs", args->pairs,
                     "File of 'REF TEST' lines ('-': stdin; a tab between the paths allows spaces in them): "
                     "compare every pair, one JSON object per line; exit 2 if any pair could not be compared");
-    sub->add_option("--metric", args->metric, "flip|ssim|psnr|all")
-        ->check(CLI::IsMember({"flip", "ssim", "psnr", "all"}));
-    sub->add_option("--mode", args->mode, "auto|ldr|hdr (auto: EXR/HDR -> hdr)")
-        ->check(CLI::IsMember({"auto", "ldr", "hdr"}));
+    sub->add_option("--metric", args->metric, "flip|ssim|psnr|all")->check(CLI::IsMember({"flip", "ssim", "psnr", "all"}));
+    sub->add_option("--mode", args->mode, "auto|ldr|hdr (auto: EXR/HDR -> hdr)")->check(CLI::IsMember({"auto", "ldr", "hdr"}));
     sub->add_option("--heatmap", args->heatmap, "Write the FLIP error map as a magma PNG");
     sub->add_option("--errmap", args->errmap, "Write the FLIP error map as a float EXR");
     sub->add_flag("--json", args->json, "Print one JSON object");
@@ -294,8 +287,7 @@ void register_compare_command(CLI::App& app, int& exit_code) {
             exit_code = run_compare(*args, std::cout, std::cerr);
             return;
         }
-        if (!args->reference.empty() || !args->test.empty())
-            throw UsageError("compare: give REF TEST or --pairs LIST, not both");
+        if (!args->reference.empty() || !args->test.empty()) throw UsageError("compare: give REF TEST or --pairs LIST, not both");
         if (args->pairs == "-") {
             exit_code = run_compare_pairs(*args, std::cin, "stdin", std::cout, std::cerr);
             return;

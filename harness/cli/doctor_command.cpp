@@ -42,8 +42,8 @@ void print_golden_sets(const std::string& driver_info) {
         std::string label = p.value("label", std::string());
         Set& s = sets[label.empty() ? "primary" : "@" + label];
         ++s.count;
-        s.platforms.insert(p.value("driver", nlohmann::json::object()).value("driver_info", std::string("?")) +
-                           " | CPU class " + p.value("cpu_class", std::string("unrecorded")));
+        s.platforms.insert(p.value("driver", nlohmann::json::object()).value("driver_info", std::string("?")) + " | CPU class " +
+                           p.value("cpu_class", std::string("unrecorded")));
     }
     const std::string here = driver_info + " | CPU class " + this_cpu_class();
     fmt::print("golden sets ({}):\n", dir.string());
@@ -87,8 +87,7 @@ void register_doctor_command(CLI::App& app, int& exit_code) {
         auto yn = [](bool b) { return b ? "yes" : "no"; };
         fmt::print("llvmpipe cpu:    {} (vector width {} bits; F16C {}, FMA {}, AVX2 {}, AVX-512 {})\n", caps.cpu_class(),
                    caps.vector_width, yn(caps.f16c), yn(caps.fma), yn(caps.avx2), yn(caps.avx512));
-        if (!caps.override_caps.empty())
-            fmt::print("cpu override:    GALLIUM_OVERRIDE_CPU_CAPS={}\n", caps.override_caps);
+        if (!caps.override_caps.empty()) fmt::print("cpu override:    GALLIUM_OVERRIDE_CPU_CAPS={}\n", caps.override_caps);
         if (!caps.warning.empty()) fmt::print(stderr, "warning: {}\n", caps.warning);
         print_golden_sets(i.driver_info);
         fmt::print("all devices:\n");

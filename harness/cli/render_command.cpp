@@ -31,10 +31,8 @@ void print_render_summary(FILE* human, const RenderResult& r) {
     fmt::print(human, "{:<20} {:9.3f} ms\n", "total", total);
     fmt::print(human, "texture samples/px  {:.2f}\n", r.texture_fetches_per_pixel);
     // The deterministic cost (issue 14): the same on every run, where the times above are not.
-    if (r.shader_instructions_per_pixel > 0)
-        fmt::print(human, "spirv instr/px      {:.2f}\n", r.shader_instructions_per_pixel);
-    if (r.texture_bytes > 0)
-        fmt::print(human, "env texture         {} texels, {} bytes\n", r.texel_count, r.texture_bytes);
+    if (r.shader_instructions_per_pixel > 0) fmt::print(human, "spirv instr/px      {:.2f}\n", r.shader_instructions_per_pixel);
+    if (r.texture_bytes > 0) fmt::print(human, "env texture         {} texels, {} bytes\n", r.texel_count, r.texture_bytes);
 }
 
 // `render --json`: provenance, cost and timings.

@@ -60,7 +60,8 @@ void register_run(CLI::App& app, int& exit_code) {
     r->add_flag("--list", list_only, "Print the selected tests' names and exit");
     r->add_flag("--stability", run.stability, "Also measure determinism, noise floors, sensitivity and margins");
     static int repeat = 1;
-    r->add_option("--repeat", repeat, "Run the suite N times; exit 1 if any verdict changes between runs")->check(CLI::Range(1, 100));
+    r->add_option("--repeat", repeat, "Run the suite N times; exit 1 if any verdict changes between runs")
+        ->check(CLI::Range(1, 100));
     r->callback([&exit_code] {
         parse_shard(shard, run.shard_index, run.shard_count);
         if (const char* gi = std::getenv("GTEST_SHARD_INDEX"); gi && shard.empty()) run.shard_index = std::atoi(gi);
@@ -97,7 +98,7 @@ void register_bless(CLI::App& app, int& exit_code) {
     b->add_flag("--dry-run", bo.dry_run, "Show what would change, write nothing");
     b->callback([&exit_code, label_opt] {
         bo.goldens = bless_goldens;
-        if (label_opt->count() > 0) bo.label = label;  // given, even empty: check_label refuses ""
+        if (label_opt->count() > 0) bo.label = label; // given, even empty: check_label refuses ""
         exit_code = bless(bo);
     });
 }
@@ -106,8 +107,8 @@ void register_bless(CLI::App& app, int& exit_code) {
 void register_bisect(CLI::App& app, int& exit_code) {
     static RunOptions bis;
     static std::string bis_goldens;
-    auto* s = app.add_subcommand("bisect",
-                                 "git bisect run contract: exit 0 good, 1 bad, 125 cannot test (shader compile failure)");
+    auto* s =
+        app.add_subcommand("bisect", "git bisect run contract: exit 0 good, 1 bad, 125 cannot test (shader compile failure)");
     s->add_option("--suite", bis.suite, "Suite name or path")->capture_default_str();
     s->add_option("--filter", bis.filter, "Glob on test names (required: keep it to the failing tests)")->required();
     s->add_option("--goldens", bis_goldens, "Golden folder to judge against (copy the good goldens out of the tree)");
@@ -127,9 +128,12 @@ void register_bisect(CLI::App& app, int& exit_code) {
             exit_code = kExitCannotTest;
             return;
         }
-        if (sum.shader_compile_error) exit_code = kExitCannotTest;
-        else if (sum.error) exit_code = kExitCannotTest;
-        else exit_code = (sum.fail || sum.missing) ? 1 : 0;
+        if (sum.shader_compile_error)
+            exit_code = kExitCannotTest;
+        else if (sum.error)
+            exit_code = kExitCannotTest;
+        else
+            exit_code = (sum.fail || sum.missing) ? 1 : 0;
         fmt::print("bisect verdict: {}\n", exit_code == 0 ? "good" : exit_code == 1 ? "bad" : "skip (125)");
     });
 }

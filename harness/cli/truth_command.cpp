@@ -59,12 +59,15 @@ void register_truth_command(CLI::App& app, int& exit_code) {
     static int frames = 0;
     cmd->add_option("--scene", scene, "Scene name (iblcheck list)")->capture_default_str();
     cmd->add_option("--env", env, "Environment: a spec (iblcheck list) or a path to your own .exr/.hdr")->required();
-    cmd->add_option("--out", out, "Golden EXR to write (default: <reference key>.exr in the current folder); the "
-                                  "sidecar is the same path with .json");
-    cmd->add_option("--set", sets, "Option key=value (repeatable): material options, env_rotation, threads, "
-                                   "truth_tolerance (the coarser level's pixel tolerance)");
-    cmd->add_option("--frames", frames, "Render the temporal truth: frames 0..N-1 (option frame) stacked vertically "
-                                        "in one golden, as the temporal suite reads it (reference/<key>__frames=N.exr)");
+    cmd->add_option("--out", out,
+                    "Golden EXR to write (default: <reference key>.exr in the current folder); the "
+                    "sidecar is the same path with .json");
+    cmd->add_option("--set", sets,
+                    "Option key=value (repeatable): material options, env_rotation, threads, "
+                    "truth_tolerance (the coarser level's pixel tolerance)");
+    cmd->add_option("--frames", frames,
+                    "Render the temporal truth: frames 0..N-1 (option frame) stacked vertically "
+                    "in one golden, as the temporal suite reads it (reference/<key>__frames=N.exr)");
     cmd->add_flag("--force", force, "Overwrite existing output files");
     cmd->callback([&exit_code] {
         truth::GoldenRequest req;
@@ -76,7 +79,8 @@ void register_truth_command(CLI::App& app, int& exit_code) {
         // The file name from the golden store's key, with the environment as recorded (a path: its name).
         TestSpec keyed = req.spec;
         keyed.env = truth::portable_env_spec(env);
-        req.out_exr = out.empty() ? reference_key(keyed) + (frames > 0 ? "__frames=" + std::to_string(frames) : "") + ".exr" : out;
+        req.out_exr =
+            out.empty() ? reference_key(keyed) + (frames > 0 ? "__frames=" + std::to_string(frames) : "") + ".exr" : out;
         const fs::path json = fs::path(req.out_exr).replace_extension(".json");
         if (!force)
             for (const fs::path& p : {fs::path(req.out_exr), json})

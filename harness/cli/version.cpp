@@ -5,8 +5,8 @@
 namespace iblcheck::cli {
 
 std::string version_string() {
-    return std::string("iblcheck ") + IBLCHECK_VERSION + " (commit " + IBLCHECK_GIT_COMMIT + ", " +
-           IBLCHECK_COMPILER + ", " + IBLCHECK_BUILD_TYPE + ")";
+    return std::string("iblcheck ") + IBLCHECK_VERSION + " (commit " + IBLCHECK_GIT_COMMIT + ", " + IBLCHECK_COMPILER + ", " +
+           IBLCHECK_BUILD_TYPE + ")";
 }
 
 } // namespace iblcheck::cli

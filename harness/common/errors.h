@@ -9,7 +9,7 @@ namespace iblcheck {
 // Exit codes of the whole CLI.
 inline constexpr int kExitPass = 0;
 inline constexpr int kExitRegression = 1;
-inline constexpr int kExitError = 2;       // usage, input or environment error
+inline constexpr int kExitError = 2;        // usage, input or environment error
 inline constexpr int kExitCannotTest = 125; // `git bisect run`: skip this commit
 
 struct Error : std::runtime_error {

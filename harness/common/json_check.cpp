@@ -58,8 +58,8 @@ void JsonChecker::keys(const nlohmann::json& j, const std::string& where, const 
         if (!allowed.count(k)) fail(where + "." + k, fmt::format("unknown key; valid: {}", fmt::join(allowed, ", ")));
 }
 
-const nlohmann::json* JsonChecker::member(const nlohmann::json& obj, const std::string& where, const char* key,
-                                          JsonType type, bool required) const {
+const nlohmann::json* JsonChecker::member(const nlohmann::json& obj, const std::string& where, const char* key, JsonType type,
+                                          bool required) const {
     auto it = obj.find(key);
     if (it == obj.end() || it->is_null()) {
         if (required) fail(where, fmt::format("missing key '{}'", key));

@@ -17,8 +17,10 @@ inline std::string escape_markup(std::string_view s) {
         case '"': o += "&quot;"; break;
         case '\'': o += "&#39;"; break;
         default:
-            if (static_cast<unsigned char>(c) < 0x20 && c != '\n' && c != '\t' && c != '\r') o += ' ';
-            else o += c;
+            if (static_cast<unsigned char>(c) < 0x20 && c != '\n' && c != '\t' && c != '\r')
+                o += ' ';
+            else
+                o += c;
         }
     }
     return o;

@@ -26,8 +26,7 @@ double parse_double(const std::string& key, const std::string& text) {
 
 void OptionMap::set_from_string(const std::string& kv) {
     auto eq = kv.find('=');
-    if (eq == std::string::npos || eq == 0)
-        throw UsageError("option '" + kv + "' is not of the form key=value");
+    if (eq == std::string::npos || eq == 0) throw UsageError("option '" + kv + "' is not of the form key=value");
     values_[kv.substr(0, eq)] = kv.substr(eq + 1);
 }
 
@@ -71,8 +70,7 @@ Vec3f OptionMap::get_vec3(const std::string& key, Vec3f def) const {
     throw UsageError("option '" + key + "': '" + it->second + "' needs 1 or 3 comma-separated numbers");
 }
 
-std::string OptionMap::get_choice(const std::string& key, const std::string& def,
-                                  const std::vector<std::string>& allowed) const {
+std::string OptionMap::get_choice(const std::string& key, const std::string& def, const std::vector<std::string>& allowed) const {
     std::string v = get_string(key, def);
     for (const auto& a : allowed)
         if (a == v) return v;

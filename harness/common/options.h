@@ -29,8 +29,7 @@ class OptionMap {
     bool get_bool(const std::string& key, bool def) const;
     Vec3f get_vec3(const std::string& key, Vec3f def) const; // "r,g,b" or a single value
     // A string that must be one of `allowed`; throws UsageError listing them otherwise.
-    std::string get_choice(const std::string& key, const std::string& def,
-                           const std::vector<std::string>& allowed) const;
+    std::string get_choice(const std::string& key, const std::string& def, const std::vector<std::string>& allowed) const;
 
     // Throws UsageError naming every key not in `known` (and listing the known ones).
     void check_known(const std::set<std::string>& known, const std::string& context) const;

@@ -23,12 +23,9 @@ inline float linear_to_srgb(float c) {
 
 // Linear sRGB primaries -> CIE XYZ, D65, exact rational coefficients (the tool's matrix).
 IBLCHECK_FLIP_INLINE void linear_rgb_to_xyz(float r, float g, float b, float& x, float& y, float& z) {
-    constexpr float a11 = 10135552.0f / 24577794.0f, a12 = 8788810.0f / 24577794.0f,
-                    a13 = 4435075.0f / 24577794.0f;
-    constexpr float a21 = 2613072.0f / 12288897.0f, a22 = 8788810.0f / 12288897.0f,
-                    a23 = 887015.0f / 12288897.0f;
-    constexpr float a31 = 1425312.0f / 73733382.0f, a32 = 8788810.0f / 73733382.0f,
-                    a33 = 70074185.0f / 73733382.0f;
+    constexpr float a11 = 10135552.0f / 24577794.0f, a12 = 8788810.0f / 24577794.0f, a13 = 4435075.0f / 24577794.0f;
+    constexpr float a21 = 2613072.0f / 12288897.0f, a22 = 8788810.0f / 12288897.0f, a23 = 887015.0f / 12288897.0f;
+    constexpr float a31 = 1425312.0f / 73733382.0f, a32 = 8788810.0f / 73733382.0f, a33 = 70074185.0f / 73733382.0f;
     x = a11 * r + a12 * g + a13 * b;
     y = a21 * r + a22 * g + a23 * b;
     z = a31 * r + a32 * g + a33 * b;

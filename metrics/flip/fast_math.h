@@ -43,15 +43,18 @@ IBLCHECK_FLIP_INLINE float fast_exp2(float y) {
     y = y < -126.0f ? -126.0f : (y > 127.0f ? 127.0f : y);
     const float n = float(int32_t(y + (y >= 0.0f ? 0.5f : -0.5f)));
     const float f = (y - n) * 0.693147180559945309f;
-    const float p = 1.0f + f * (1.0f + f * (0.5f + f * (1.0f / 6.0f + f * (1.0f / 24.0f + f * (1.0f / 120.0f + f * (1.0f / 720.0f + f * (1.0f / 5040.0f)))))));
+    const float p =
+        1.0f +
+        f * (1.0f + f * (0.5f + f * (1.0f / 6.0f +
+                                     f * (1.0f / 24.0f + f * (1.0f / 120.0f + f * (1.0f / 720.0f + f * (1.0f / 5040.0f)))))));
     const float scale = std::bit_cast<float>((int32_t(n) + 127) << 23);
     return p * scale;
 }
 
 // x^p for x >= 0, p >= 0, with pow's conventions 0^0 = 1 and 0^p = 0 (p > 0).
 IBLCHECK_FLIP_INLINE float fast_pow(float x, float p) {
-    const float tiny = x > 1e-30f ? 0.0f : 1.0f;           // arithmetic masks keep the loop
-    const float r = fast_exp2(p * fast_log2(x + tiny));     // branch-free (vectorises under AVX2)
+    const float tiny = x > 1e-30f ? 0.0f : 1.0f;        // arithmetic masks keep the loop
+    const float r = fast_exp2(p * fast_log2(x + tiny)); // branch-free (vectorises under AVX2)
     const float zero_value = p == 0.0f ? 1.0f : 0.0f;
     return r * (1.0f - tiny) + zero_value * tiny;
 }

@@ -33,9 +33,15 @@ inline FeatureFilters make_feature_filters(float ppd) {
         const float g = std::exp(-(x * x) / (2.0f * sd * sd));
         g_sum += g;
         const float dg = -x * g;
-        if (dg > 0.0f) dg_pos += dg; else dg_neg -= dg;
+        if (dg > 0.0f)
+            dg_pos += dg;
+        else
+            dg_neg -= dg;
         const float ddg = (x * x / (sd * sd) - 1.0f) * g;
-        if (ddg > 0.0f) ddg_pos += ddg; else ddg_neg -= ddg;
+        if (ddg > 0.0f)
+            ddg_pos += ddg;
+        else
+            ddg_neg -= ddg;
         f.g[i] = g;
         f.dg[i] = dg;
         f.ddg[i] = ddg;

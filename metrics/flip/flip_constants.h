@@ -13,13 +13,13 @@ inline constexpr float kPi = 3.14159265358979f;
 inline constexpr float kDefaultPpd = 0.7f * (3840.0f / 0.7f) * (kPi / 180.0f);
 
 // Colour pipeline (FLIP paper, Sec. 4.1).
-inline constexpr float kQc = 0.7f;   // exponent compressing the HyAB colour distance (Eq. 6)
-inline constexpr float kPc = 0.4f;   // break point of the error redistribution (Eq. 7), fraction of cmax
-inline constexpr float kPt = 0.95f;  // error value mapped to at the break point (Eq. 7)
+inline constexpr float kQc = 0.7f;  // exponent compressing the HyAB colour distance (Eq. 6)
+inline constexpr float kPc = 0.4f;  // break point of the error redistribution (Eq. 7), fraction of cmax
+inline constexpr float kPt = 0.95f; // error value mapped to at the break point (Eq. 7)
 
 // Feature pipeline (FLIP paper, Sec. 4.2).
-inline constexpr float kW = 0.082f;  // feature-filter width in degrees; std dev = 0.5 * w * ppd
-inline constexpr float kQf = 0.5f;   // exponent of the feature difference (Eq. 9)
+inline constexpr float kW = 0.082f; // feature-filter width in degrees; std dev = 0.5 * w * ppd
+inline constexpr float kQf = 0.5f;  // exponent of the feature difference (Eq. 9)
 
 // Contrast sensitivity functions as sums of Gaussians in the frequency domain (FLIP paper,
 // Eq. 2 and Table 1): per opponent channel (achromatic A / Y, red-green RG / Cx, blue-yellow

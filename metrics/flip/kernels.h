@@ -22,13 +22,11 @@ struct Kernels {
     void (*fir)(const float* const* src, const float* const* taps, int nf, int ntaps, int n, float* const* out);
     // Interleaved RGB of an 8-bit sRGB image (values k/255) -> linear planes, clamped to [0,1],
     // through the 256-entry tables; a value that is not k/255 gives -1 (the caller applies the formula).
-    void (*srgb_to_linear)(const float* rgb, int n, const float* code, const float* linear, float* r, float* g,
-                           float* b);
+    void (*srgb_to_linear)(const float* rgb, int n, const float* code, const float* linear, float* r, float* g, float* b);
     // Interleaved linear RGB -> planes of HDR-FLIP's input for one exposure: * m, tone mapped, clamped.
     void (*expose_tone_map)(const float* rgb, int n, float m, ToneMapper tm, float* r, float* g, float* b);
     // Linear RGB -> YCxCz (Y, Cx, Cz) and the feature channel Yn = Y / 116 + 16 / 116.
-    void (*rgb_to_ycxcz)(const float* r, const float* g, const float* b, int n, float* y, float* cx, float* cz,
-                         float* yn);
+    void (*rgb_to_ycxcz)(const float* r, const float* g, const float* b, int n, float* y, float* cx, float* cz, float* yn);
     // Per-pixel FLIP from the 16 vertically filtered planes q[img * 8 + i] (i: Y, Cx, Cz1, Cz2, dx, ddx,
     // dy, ddy); cmax and pc * cmax of the colour pipeline. With max_merge, out = max(out, FLIP).
     void (*flip_pixels)(const float* const* q, int n, float cmax, float pccmax, float* out, bool max_merge);

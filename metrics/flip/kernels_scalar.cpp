@@ -23,8 +23,8 @@ void srgb_to_linear(const float* __restrict rgb, int n, const float* __restrict 
     for (int x = 0; x < n; ++x) b[x] = pixel::srgb_code_to_linear(rgb[3 * x + 2], code, linear);
 }
 
-void expose_tone_map(const float* __restrict rgb, int n, float m, ToneMapper tm, float* __restrict r,
-                     float* __restrict g, float* __restrict b) {
+void expose_tone_map(const float* __restrict rgb, int n, float m, ToneMapper tm, float* __restrict r, float* __restrict g,
+                     float* __restrict b) {
     // One loop per tone mapper, so the choice is not made per pixel.
     switch (tm) {
     case ToneMapper::reinhard:

@@ -27,7 +27,7 @@ const Kernels& kernels_named(const std::string& name) {
 }
 
 const Kernels& default_kernels() {
-    static const Kernels& k = [] () -> const Kernels& {
+    static const Kernels& k = []() -> const Kernels& {
         if (const char* env = std::getenv("IBLCHECK_FLIP_KERNELS"); env && *env) return kernels_named(env);
 #if defined(__x86_64__)
         if (cpu_has_avx2()) return avx2_kernels();

@@ -88,8 +88,7 @@ IBLCHECK_FLIP_INLINE float flip_value(const float* v, float cmax, float pccmax) 
     const float dxr = v[4], ddxr = v[5], dyr = v[6], ddyr = v[7];
     const float dxt = v[12], ddxt = v[13], dyt = v[14], ddyt = v[15];
     const float edge = __builtin_fabsf(__builtin_sqrtf(dxr * dxr + dyr * dyr) - __builtin_sqrtf(dxt * dxt + dyt * dyt));
-    const float point =
-        __builtin_fabsf(__builtin_sqrtf(ddxr * ddxr + ddyr * ddyr) - __builtin_sqrtf(ddxt * ddxt + ddyt * ddyt));
+    const float point = __builtin_fabsf(__builtin_sqrtf(ddxr * ddxr + ddyr * ddyr) - __builtin_sqrtf(ddxt * ddxt + ddyt * ddyt));
     const float fdiff = __builtin_sqrtf(norm * (edge > point ? edge : point)); // ^qf, qf = 0.5
     // Eq. 10: features sharpen the colour error towards 1.
     return fast_pow(cdiff, 1.0f - fdiff);

@@ -15,8 +15,7 @@ namespace iblcheck::flip {
 // The tool's printed "weighted median" / quartiles: with the error values sorted ascending and
 // summed in float, the first value at which the running sum exceeds fraction * total, where total
 // is the float sum in row order. `sorted` must be ascending; `total_float` the row-order sum.
-inline float weighted_percentile_sorted(const std::vector<float>& sorted, float total_float,
-                                        float fraction) {
+inline float weighted_percentile_sorted(const std::vector<float>& sorted, float total_float, float fraction) {
     float running = 0.0f;
     const float target = fraction * total_float;
     for (float v : sorted) {

@@ -20,9 +20,9 @@ enum class ToneMapper { reinhard = 0, aces = 1, hable = 2 };
 // + 0.14), with the fitted curve's 0.6 input pre-exposure folded in (x -> 0.6x).
 // Hable: John Hable's "Uncharted 2" filmic curve, as the FLIP tool parameterises it.
 inline constexpr float kToneCoefficients[3][6] = {
-    {0.0f, 1.0f, 0.0f, 0.0f, 1.0f, 1.0f},                                                 // Reinhard
-    {0.6f * 0.6f * 2.51f, 0.6f * 0.03f, 0.0f, 0.6f * 0.6f * 2.43f, 0.6f * 0.59f, 0.14f},  // ACES
-    {0.231683f, 0.013791f, 0.0f, 0.18f, 0.3f, 0.018f},                                    // Hable
+    {0.0f, 1.0f, 0.0f, 0.0f, 1.0f, 1.0f},                                                // Reinhard
+    {0.6f * 0.6f * 2.51f, 0.6f * 0.03f, 0.0f, 0.6f * 0.6f * 2.43f, 0.6f * 0.59f, 0.14f}, // ACES
+    {0.231683f, 0.013791f, 0.0f, 0.18f, 0.3f, 0.018f},                                   // Hable
 };
 
 inline ToneMapper parse_tone_mapper(const std::string& name) {
@@ -89,8 +89,6 @@ inline ExposureRange auto_exposure_range(ToneMapper tm, std::vector<float> lumin
 }
 
 // Number of exposures when not given: one per stop, at least two (the tool's rule).
-inline int auto_num_exposures(float start, float stop) {
-    return int(std::max(2.0f, std::ceil(stop - start)));
-}
+inline int auto_num_exposures(float start, float stop) { return int(std::max(2.0f, std::ceil(stop - start))); }
 
 } // namespace iblcheck::flip

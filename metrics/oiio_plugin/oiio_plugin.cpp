@@ -58,8 +58,8 @@ int read_image(const char* path, int unassociated_alpha, IblcheckOiioImage* out)
     return kOiioOk;
 }
 
-int write_image(const char* path, int width, int height, int channels, int is_float, const void* data,
-                char* error, size_t error_size) {
+int write_image(const char* path, int width, int height, int channels, int is_float, const void* data, char* error,
+                size_t error_size) {
     auto out = OIIO::ImageOutput::create(path);
     if (!out) {
         set_error(error, error_size, OIIO::geterror());
@@ -82,7 +82,7 @@ int write_image(const char* path, int width, int height, int channels, int is_fl
 } // namespace
 
 extern "C" __attribute__((visibility("default"))) int iblcheck_oiio_read_v1(const char* path, int unassociated_alpha,
-                                                                           IblcheckOiioImage* out) {
+                                                                            IblcheckOiioImage* out) {
     try {
         return read_image(path, unassociated_alpha, out);
     } catch (const std::exception& e) {
@@ -92,9 +92,8 @@ extern "C" __attribute__((visibility("default"))) int iblcheck_oiio_read_v1(cons
 }
 
 extern "C" __attribute__((visibility("default"))) int iblcheck_oiio_write_v1(const char* path, int width, int height,
-                                                                            int channels, int is_float,
-                                                                            const void* data, char* error,
-                                                                            size_t error_size) {
+                                                                             int channels, int is_float, const void* data,
+                                                                             char* error, size_t error_size) {
     try {
         return write_image(path, width, height, channels, is_float, data, error, error_size);
     } catch (const std::exception& e) {

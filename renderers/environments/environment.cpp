@@ -17,7 +17,7 @@ namespace iblcheck {
 
 namespace {
 constexpr double kPi = 3.14159265358979323846;
-const std::vector<std::string> kBlenderNames = {"city",  "courtyard", "forest", "interior",
+const std::vector<std::string> kBlenderNames = {"city",  "courtyard", "forest",  "interior",
                                                 "night", "studio",    "sunrise", "sunset"};
 
 std::string lower(std::string s) {
@@ -37,8 +37,7 @@ std::string valid_specs() {
 
 void finish(Environment& env) {
     if (env.equirect.cols != 2 * env.equirect.rows)
-        throw InputError("environment '" + env.spec + "'" +
-                         (env.source_path.empty() ? "" : " (" + env.source_path + ")") + ": " +
+        throw InputError("environment '" + env.spec + "'" + (env.source_path.empty() ? "" : " (" + env.source_path + ")") + ": " +
                          std::to_string(env.equirect.cols) + "x" + std::to_string(env.equirect.rows) +
                          " is not an equirect panorama (width must be 2 x height)");
     env.content_hash = fnv1a64_hex(env.equirect);
@@ -72,8 +71,8 @@ Environment load_file(const std::string& spec, const std::string& path) {
                 float v = p[nch >= 3 ? c : 0];
                 if (!std::isfinite(v)) {
                     if (bad++ == 0)
-                        first_bad = "pixel (" + std::to_string(x) + ", " + std::to_string(y) + ") channel " +
-                                    std::to_string(c) + " = " + (std::isnan(v) ? "NaN" : "Inf");
+                        first_bad = "pixel (" + std::to_string(x) + ", " + std::to_string(y) + ") channel " + std::to_string(c) +
+                                    " = " + (std::isnan(v) ? "NaN" : "Inf");
                     v = 0;
                 } else if (v < 0) {
                     ++env.negatives_clamped;
@@ -83,16 +82,15 @@ Environment load_file(const std::string& spec, const std::string& path) {
             }
         }
     if (bad)
-        throw InputError("environment file '" + path + "': " + std::to_string(bad) +
-                         " non-finite (NaN/Inf) values; first at " + first_bad);
+        throw InputError("environment file '" + path + "': " + std::to_string(bad) + " non-finite (NaN/Inf) values; first at " +
+                         first_bad);
     finish(env);
     return env;
 }
 
 std::string find_blender(const std::string& name) {
     std::vector<std::string> tried;
-    if (const char* dir = std::getenv("IBLCHECK_HDRI_DIR"); dir && *dir)
-        tried.push_back(std::string(dir) + "/" + name + ".exr");
+    if (const char* dir = std::getenv("IBLCHECK_HDRI_DIR"); dir && *dir) tried.push_back(std::string(dir) + "/" + name + ".exr");
     tried.push_back("/usr/share/blender/datafiles/studiolights/world/" + name + ".exr");
 #ifdef IBLCHECK_SOURCE_DIR
     tried.push_back(std::string(IBLCHECK_SOURCE_DIR) + "/.cache/blender-hdri/" + name + ".exr");
@@ -195,8 +193,7 @@ void bilinear_equirect(const float* data, int W, int H, size_t stride, double u,
     const float* r0 = data + size_t(y0) * stride;
     const float* r1 = data + size_t(y1) * stride;
     const float *a = r0 + 3 * x0, *b = r0 + 3 * x1, *c = r1 + 3 * x0, *e = r1 + 3 * x1;
-    for (int k = 0; k < 3; ++k)
-        rgb[k] = (1 - fy) * ((1 - fx) * a[k] + fx * b[k]) + fy * ((1 - fx) * c[k] + fx * e[k]);
+    for (int k = 0; k < 3; ++k) rgb[k] = (1 - fy) * ((1 - fx) * a[k] + fx * b[k]) + fy * ((1 - fx) * c[k] + fx * e[k]);
 }
 
 void sample_bilinear(const Environment& env, const float d_in[3], float rgb[3]) {

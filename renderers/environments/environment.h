@@ -23,8 +23,8 @@
 namespace iblcheck {
 
 struct Environment {
-    std::string spec;        // as given
-    cv::Mat equirect;        // CV_32FC3, linear, width = 2·height
+    std::string spec; // as given
+    cv::Mat equirect; // CV_32FC3, linear, width = 2·height
     long negatives_clamped = 0;
     std::string content_hash; // hex FNV-1a-64 of the pixel data, for provenance
     std::string source_path;  // file it came from, empty for procedural

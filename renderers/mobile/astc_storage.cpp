@@ -73,10 +73,14 @@ void rgbm_encode(const float rgb[3], float range, float out[4]) {
 float half_bits_to_float(uint16_t h) {
     uint32_t sign = uint32_t(h >> 15) << 31, exp = (h >> 10) & 0x1f, mant = h & 0x3ff, bits;
     if (exp == 0) {
-        if (mant == 0) bits = sign;
-        else {  // subnormal: normalise the mantissa
+        if (mant == 0)
+            bits = sign;
+        else { // subnormal: normalise the mantissa
             int e = -1;
-            do { ++e; mant <<= 1; } while (!(mant & 0x400));
+            do {
+                ++e;
+                mant <<= 1;
+            } while (!(mant & 0x400));
             bits = sign | uint32_t(127 - 15 - e) << 23 | (mant & 0x3ff) << 13;
         }
     } else if (exp == 31) {
@@ -103,8 +107,8 @@ AstcCodec::AstcCodec(const AstcFormat& format) : format_(format) {
     // (M quantised to 0: black texels) is prevented by the M floor its documentation asks for
     // (kAstcRgbmMinM, applied in rgbm_encode), and M's error is weighted 2·range as it recommends,
     // since an error in M scales all three channels by up to `range`.
-    check(astcenc_config_init(hdr ? ASTCENC_PRF_HDR_RGB_LDR_A : ASTCENC_PRF_LDR, format.block, format.block, 1,
-                              kAstcQuality, 0, &config),
+    check(astcenc_config_init(hdr ? ASTCENC_PRF_HDR_RGB_LDR_A : ASTCENC_PRF_LDR, format.block, format.block, 1, kAstcQuality, 0,
+                              &config),
           "config_init");
     if (!hdr) config.cw_a_weight = 2.0f * format.rgbm_range;
     check(astcenc_context_alloc(&config, 1, &ctx_), "context_alloc");

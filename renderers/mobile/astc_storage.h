@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-struct astcenc_context;  // astcenc.h (kept out of this header)
+struct astcenc_context; // astcenc.h (kept out of this header)
 
 namespace iblcheck {
 
@@ -34,8 +34,8 @@ enum class AstcProfile {
 
 struct AstcFormat {
     AstcProfile profile = AstcProfile::hdr;
-    uint32_t block = 4;       // square block footprint: 4 (4x4, 8 bpp) or 6 (6x6, 3.56 bpp)
-    float rgbm_range = 6.0f;  // ldr_rgbm only
+    uint32_t block = 4;      // square block footprint: 4 (4x4, 8 bpp) or 6 (6x6, 3.56 bpp)
+    float rgbm_range = 6.0f; // ldr_rgbm only
 };
 
 // "4x4" → 4, "6x6" → 6; UsageError naming option 'astc_block' otherwise.
@@ -54,7 +54,7 @@ void rgbm_encode(const float rgb[3], float range, float out_rgbm[4]);
 struct AstcRoundTrip {
     std::vector<uint16_t> decoded_half; // width × height × 4
     uint64_t bytes = 0;
-    double encode_ms = 0;  // wall time of astcenc_compress_image (one thread)
+    double encode_ms = 0; // wall time of astcenc_compress_image (one thread)
     double decode_ms = 0;
 };
 

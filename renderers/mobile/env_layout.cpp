@@ -38,8 +38,7 @@ LayoutExtent layout_extent(EnvLayout layout, uint32_t n) {
 uint64_t layout_texel_count(EnvLayout layout, uint32_t cube_size, uint32_t mips) {
     LayoutExtent e = layout_extent(layout, cube_size);
     uint64_t total = 0;
-    for (uint32_t m = 0; m < mips; ++m)
-        total += uint64_t(std::max(1u, e.width >> m)) * std::max(1u, e.height >> m) * e.layers;
+    for (uint32_t m = 0; m < mips; ++m) total += uint64_t(std::max(1u, e.width >> m)) * std::max(1u, e.height >> m) * e.layers;
     return total;
 }
 
@@ -48,11 +47,10 @@ void check_layout_mips(EnvLayout layout, uint32_t cube_size, uint32_t mips) {
     LayoutExtent e = layout_extent(layout, cube_size);
     uint32_t w = std::max(1u, e.width >> (mips - 1)), h = std::max(1u, e.height >> (mips - 1));
     if (std::min(w, h) < 3)
-        throw UsageError("option 'env_layout': " + std::string(layout_name(layout)) + " with cube_size=" +
-                         std::to_string(cube_size) + " and mips=" + std::to_string(mips) + " ends at a " +
+        throw UsageError("option 'env_layout': " + std::string(layout_name(layout)) +
+                         " with cube_size=" + std::to_string(cube_size) + " and mips=" + std::to_string(mips) + " ends at a " +
                          std::to_string(w) + "x" + std::to_string(h) +
-                         " level, which leaves nothing inside its 1-texel border; use mips <= " +
-                         std::to_string(mips - 1));
+                         " level, which leaves nothing inside its 1-texel border; use mips <= " + std::to_string(mips - 1));
 }
 
 Uv octahedral_encode(const Dir& d) {
@@ -91,14 +89,20 @@ std::array<int, 2> gutter_source(EnvLayout layout, std::array<int, 2> j, std::ar
     if (layout == EnvLayout::octahedral) {
         // Each edge folds onto itself about its midpoint: beyond x = 0 (or n−1) is the same column
         // mirrored in y; then the same for y (a corner lands on the opposite corner).
-        if (j[0] < 0) j = {0, n[1] - 1 - j[1]};
-        else if (j[0] >= n[0]) j = {n[0] - 1, n[1] - 1 - j[1]};
-        if (j[1] < 0) j = {n[0] - 1 - j[0], 0};
-        else if (j[1] >= n[1]) j = {n[0] - 1 - j[0], n[1] - 1};
+        if (j[0] < 0)
+            j = {0, n[1] - 1 - j[1]};
+        else if (j[0] >= n[0])
+            j = {n[0] - 1, n[1] - 1 - j[1]};
+        if (j[1] < 0)
+            j = {n[0] - 1 - j[0], 0};
+        else if (j[1] >= n[1])
+            j = {n[0] - 1 - j[0], n[1] - 1};
     } else if (layout == EnvLayout::equirect) {
         // Beyond a pole: the pole row, half a turn around; longitude wraps.
-        if (j[1] < 0) j = {j[0] + n[0] / 2, 0};
-        else if (j[1] >= n[1]) j = {j[0] + n[0] / 2, n[1] - 1};
+        if (j[1] < 0)
+            j = {j[0] + n[0] / 2, 0};
+        else if (j[1] >= n[1])
+            j = {j[0] + n[0] / 2, n[1] - 1};
         j[0] = ((j[0] % n[0]) + n[0]) % n[0];
     }
     return j;
@@ -113,7 +117,9 @@ Dir layout_texel_direction(EnvLayout layout, uint32_t x, uint32_t y, uint32_t w,
 
 double layout_texel_solid_angle(EnvLayout layout, uint32_t x, uint32_t y, uint32_t w, uint32_t h, int sub) {
     const double nx = double(w) - 2, ny = double(h) - 2;
-    auto decode = [&](double u, double v) { return layout == EnvLayout::octahedral ? octahedral_decode({u, v}) : equirect_decode({u, v}); };
+    auto decode = [&](double u, double v) {
+        return layout == EnvLayout::octahedral ? octahedral_decode({u, v}) : equirect_decode({u, v});
+    };
     double total = 0, du = 1.0 / (nx * sub), dv = 1.0 / (ny * sub), e = 1e-7;
     for (int b = 0; b < sub; ++b)
         for (int a = 0; a < sub; ++a) {

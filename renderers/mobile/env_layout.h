@@ -42,8 +42,8 @@ using Uv = std::array<double, 2>;
 
 // Octahedral map (Praun & Hoppe 2003; the form of Cigolle et al. 2014, "A Survey of Efficient
 // Representations for Independent Unit Vectors", listing 1): +Z at the centre, −Z at the corners.
-Uv octahedral_encode(const Dir& d);   // unit d → [0, 1]²
-Dir octahedral_decode(const Uv& uv);  // [0, 1]² → unit direction
+Uv octahedral_encode(const Dir& d);  // unit d → [0, 1]²
+Dir octahedral_decode(const Uv& uv); // [0, 1]² → unit direction
 // Lat-long, the environment's own convention (environment.h): u = 0.5 + atan2(x, −z)/2π, v = acos(y)/π.
 Uv equirect_encode(const Dir& d);
 Dir equirect_decode(const Uv& uv);

@@ -10,7 +10,7 @@ namespace iblcheck {
 
 namespace {
 const std::vector<VkDescriptorType> kTypes = {kStorageBuffer, kSampled, kStorageBuffer, kSampled, kSampled};
-constexpr uint32_t kQuadVertices = 4;  // a triangle strip per sphere
+constexpr uint32_t kQuadVertices = 4; // a triangle strip per sphere
 
 // One draw of every sphere's impostor into `target`. With a timer, a one-pixel draw first makes
 // llvmpipe build the fragment shader's variant outside the timed region (it compiles at the first
@@ -61,11 +61,11 @@ FragmentShadingResult shade_fragment(GpuSession& gpu, const FragmentShadingPass&
     ShadePush push = pass.push;
     push.width = fw;
     push.height = fh;
-    vk::TargetFormat format;  // RGBA32F colour, D32 depth, 4 samples
+    vk::TargetFormat format; // RGBA32F colour, D32 depth, 4 samples
     vk::require_target_support(ctx, format);
 
-    const vk::GraphicsPipeline& pipeline =
-        gpu.graphics_pipeline("shade_spheres.vert", "shade_spheres.frag", pass.defines, kTypes, sizeof push, format, pass.options);
+    const vk::GraphicsPipeline& pipeline = gpu.graphics_pipeline("shade_spheres.vert", "shade_spheres.frag", pass.defines, kTypes,
+                                                                 sizeof push, format, pass.options);
     vk::OffscreenTarget target(ctx, fw, fh, format);
     vk::Buffer out = ctx.create_buffer(VkDeviceSize(fw) * fh * 16, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
     vk::GpuTimer timer(ctx, 1);
@@ -92,7 +92,7 @@ FragmentShadingResult shade_fragment(GpuSession& gpu, const FragmentShadingPass&
                                                                     kTypes, sizeof push, format, counting);
         vk::OffscreenTarget scratch_target(ctx, fw, fh, format);
         vk::Buffer scratch = ctx.create_buffer(out.size, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
-        vk::Buffer total = ctx.create_buffer(sizeof(uint64_t));  // zeroed at creation
+        vk::Buffer total = ctx.create_buffer(sizeof(uint64_t)); // zeroed at creation
         std::vector<vk::Binding> bindings = pass.bindings;
         bindings.push_back(vk::Binding::storage_buffer(vk::kCostBinding, total));
         ctx.submit([&](VkCommandBuffer cmd) {

@@ -11,26 +11,26 @@
 #include <vector>
 
 #include "gpu_session.h"
-#include "renderers/render_api.h"
 #include "push_constants.h"
+#include "renderers/render_api.h"
 
 namespace iblcheck {
 
 struct FragmentShadingPass {
-    vk::Defines defines;                 // the option table's, as the compute pass gets them
-    vk::CompileOptions options;          // fp16 emulation
-    std::vector<vk::Binding> bindings;   // 0..4 as the compute pass binds them (no output buffer)
-    ShadePush push;                      // width, height: the image; ssaa: supersampling factor
+    vk::Defines defines;               // the option table's, as the compute pass gets them
+    vk::CompileOptions options;        // fp16 emulation
+    std::vector<vk::Binding> bindings; // 0..4 as the compute pass binds them (no output buffer)
+    ShadePush push;                    // width, height: the image; ssaa: supersampling factor
     uint32_t sphere_count = 0;
 };
 
 struct FragmentShadingResult {
-    cv::Mat image;                       // CV_32FC3, the image's size
-    double coverage = 0;                 // mean resolved alpha: the fraction of samples covered
+    cv::Mat image;       // CV_32FC3, the image's size
+    double coverage = 0; // mean resolved alpha: the fraction of samples covered
     // Fragments that covered a sample and ran the shading, per image pixel (ssaa² per pixel
     // inside a sphere, 1 at its silhouette): what the texture fetches scale with.
     double shaded_fragments_per_pixel = 0;
-    std::vector<PassTiming> timings;     // "shade_spheres_fragment": the render pass, resolve included
+    std::vector<PassTiming> timings; // "shade_spheres_fragment": the render pass, resolve included
     // SPIR-V instructions the draw executed (vertex + fragment invocations, helpers excepted:
     // they cannot write the counter) per image pixel; nullopt where the device cannot count.
     std::optional<double> instructions_per_pixel;

@@ -15,4 +15,4 @@ bool scene_uses_ao(const Scene& scene);
 Scene scene_for(const TestSpec& spec, int& width, int& height);
 // Reads back a vec4 image (rgb + coverage) into CV_32FC3 and returns the mean coverage.
 double read_back_image(const vk::Buffer& buf, int width, int height, cv::Mat& rgb);
-}
+} // namespace iblcheck

@@ -26,7 +26,8 @@ VkFormat storage_format(const std::string& storage, bool native_r11g11b10) {
     if (storage == "r11g11b10") return native_r11g11b10 ? VK_FORMAT_B10G11R11_UFLOAT_PACK32 : VK_FORMAT_R16G16B16A16_SFLOAT;
     // ASTC: the prefilter pass writes full precision for the host's encoder (astc_storage.h).
     if (is_astc(storage)) return VK_FORMAT_R32G32B32A32_SFLOAT;
-    throw UsageError("option 'storage': unknown value '" + storage + "'; valid: rgba16f, rgba32f, rgbm8, r11g11b10, astc_hdr, astc_ldr_rgbm");
+    throw UsageError("option 'storage': unknown value '" + storage +
+                     "'; valid: rgba16f, rgba32f, rgbm8, r11g11b10, astc_hdr, astc_ldr_rgbm");
 }
 
 // Every level of every layer of `encoded` (RGBA32F, as the prefilter pass wrote it) through the
@@ -39,7 +40,8 @@ vk::Image astc_round_trip(vk::Context& ctx, const vk::Image& encoded, const Prec
     format.block = astc_block_from_option(s.astc_block);
     format.rgbm_range = s.rgbm_range;
     AstcCodec codec(format);
-    vk::Image decoded = ctx.create_image(VK_FORMAT_R16G16B16A16_SFLOAT, encoded.width, encoded.height, encoded.mips, encoded.cube);
+    vk::Image decoded =
+        ctx.create_image(VK_FORMAT_R16G16B16A16_SFLOAT, encoded.width, encoded.height, encoded.mips, encoded.cube);
     std::vector<vk::Buffer> staging;
     double encode_ms = 0, decode_ms = 0;
     for (uint32_t m = 0; m < encoded.mips; ++m) {
@@ -67,8 +69,8 @@ vk::Image astc_round_trip(vk::Context& ctx, const vk::Image& encoded, const Prec
 
 } // namespace
 
-uint64_t storage_level_bytes(const std::string& storage, const std::string& astc_block, uint32_t width,
-                             uint32_t height, uint32_t layers) {
+uint64_t storage_level_bytes(const std::string& storage, const std::string& astc_block, uint32_t width, uint32_t height,
+                             uint32_t layers) {
     if (is_astc(storage)) return astc_image_bytes(width, height, astc_block_from_option(astc_block)) * layers;
     uint64_t texels = uint64_t(width) * height * layers;
     if (storage == "rgba32f") return texels * 16;
@@ -96,7 +98,7 @@ IblResources run_precompute(GpuSession& gpu, const Environment& env, const Preco
     const EnvLayout layout = env_layout_from_option(s.env_layout);
     const LayoutExtent extent = layout_extent(layout, s.cube_size);
     if (s.prefiltered) check_layout_mips(layout, s.cube_size, mips);
-    if (is_astc(s.storage)) astc_block_from_option(s.astc_block);  // a bad block is a usage error before any work
+    if (is_astc(s.storage)) astc_block_from_option(s.astc_block); // a bad block is a usage error before any work
 
     // Upload the equirect (RGB float → RGBA32F).
     const cv::Mat& eq = env.equirect;
@@ -113,9 +115,9 @@ IblResources run_precompute(GpuSession& gpu, const Environment& env, const Preco
     vk::Image equirect = ctx.create_image(VK_FORMAT_R32G32B32A32_SFLOAT, ew, eh, 1, false);
     r.source_cube = ctx.create_image(VK_FORMAT_R32G32B32A32_SFLOAT, s.cube_size, s.cube_size, r.full_mips, true);
 
-    r.native_r11g11b10 = s.storage == "r11g11b10" &&
-                         ctx.format_supports(VK_FORMAT_B10G11R11_UFLOAT_PACK32,
-                                             VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT | VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT);
+    r.native_r11g11b10 = s.storage == "r11g11b10" && ctx.format_supports(VK_FORMAT_B10G11R11_UFLOAT_PACK32,
+                                                                         VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT |
+                                                                             VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT);
     VkFormat pf = storage_format(s.storage, r.native_r11g11b10);
     if (!ctx.format_supports(pf, VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT | VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT))
         throw EnvironmentError(ctx.info().device_name + ": storage=" + s.storage +
@@ -137,7 +139,8 @@ IblResources run_precompute(GpuSession& gpu, const Environment& env, const Preco
 
     const auto& p_e2c = gpu.pipeline("equirect_to_cube.comp", {}, {kSampled, kStorageImage}, sizeof(EquirectToCubePush));
     const auto& p_down = gpu.pipeline("downsample_cube.comp", {}, {kStorageImage, kStorageImage}, sizeof(DownsamplePush));
-    const auto& p_pre = gpu.pipeline("prefilter_ggx.comp", storage_defines(s, r.native_r11g11b10), {kSampled, kStorageImage}, sizeof(PrefilterPush));
+    const auto& p_pre = gpu.pipeline("prefilter_ggx.comp", storage_defines(s, r.native_r11g11b10), {kSampled, kStorageImage},
+                                     sizeof(PrefilterPush));
     const auto& p_sh = gpu.pipeline("sh9_project.comp", {}, {kStorageImage, kStorageBuffer}, sizeof(Sh9Push));
 
     vk::GpuTimer timer(ctx, 8);
@@ -150,8 +153,7 @@ IblResources run_precompute(GpuSession& gpu, const Environment& env, const Preco
             ctx.transition(cmd, *img, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL);
 
         // 1. equirect → cube, supersampled so each cube texel averages the equirect pixels it covers.
-        EquirectToCubePush pe{s.cube_size, std::max(1u, (ew + 4 * s.cube_size - 1) / (4 * s.cube_size)),
-                                                    s.env_rotation_deg};
+        EquirectToCubePush pe{s.cube_size, std::max(1u, (ew + 4 * s.cube_size - 1) / (4 * s.cube_size)), s.env_rotation_deg};
         std::vector<vk::Binding> be = {vk::Binding::sampled_image(0, equirect.sampled_view, ctx.equirect_sampler()),
                                        vk::Binding::storage_image(1, r.source_cube.storage_views[0])};
         p_e2c.warm_up(cmd, be, &pe, sizeof pe);
@@ -162,14 +164,17 @@ IblResources run_precompute(GpuSession& gpu, const Environment& env, const Preco
 
         if (r.full_mips > 1) {
             const DownsamplePush size1{std::max(1u, s.cube_size >> 1)};
-            p_down.warm_up(cmd, {vk::Binding::storage_image(0, r.source_cube.storage_views[0]),
-                                 vk::Binding::storage_image(1, r.source_cube.storage_views[1])}, &size1, sizeof size1);
+            p_down.warm_up(cmd,
+                           {vk::Binding::storage_image(0, r.source_cube.storage_views[0]),
+                            vk::Binding::storage_image(1, r.source_cube.storage_views[1])},
+                           &size1, sizeof size1);
         }
         timer.begin(cmd, "downsample_cube");
         for (uint32_t m = 1; m < r.full_mips; ++m) {
             const DownsamplePush size{std::max(1u, s.cube_size >> m)};
-            p_down.dispatch(cmd, {vk::Binding::storage_image(0, r.source_cube.storage_views[m - 1]),
-                                  vk::Binding::storage_image(1, r.source_cube.storage_views[m])},
+            p_down.dispatch(cmd,
+                            {vk::Binding::storage_image(0, r.source_cube.storage_views[m - 1]),
+                             vk::Binding::storage_image(1, r.source_cube.storage_views[m])},
                             &size, sizeof size, groups(size.dst_size), groups(size.dst_size), 6);
             ctx.barrier(cmd);
         }
@@ -177,21 +182,27 @@ IblResources run_precompute(GpuSession& gpu, const Environment& env, const Preco
 
         if (s.prefiltered) {
             for (uint32_t m = 0; m < mips; ++m) {
-                if (m == 0) {  // warm-up: a mip-0 copy of one workgroup, overwritten below
-                    PrefilterPush pw{
-                        0, s.cube_size, s.cube_size, s.prefilter_samples, float(r.full_mips), float(mips - 1),
-                        float(r.full_mips - 1)};
-                    p_pre.warm_up(cmd, {vk::Binding::sampled_image(0, r.source_cube.sampled_view, ctx.linear_sampler()),
-                                        vk::Binding::storage_image(1, r.prefiltered.storage_views[0])}, &pw, sizeof pw);
+                if (m == 0) { // warm-up: a mip-0 copy of one workgroup, overwritten below
+                    PrefilterPush pw{0,
+                                     s.cube_size,
+                                     s.cube_size,
+                                     s.prefilter_samples,
+                                     float(r.full_mips),
+                                     float(mips - 1),
+                                     float(r.full_mips - 1)};
+                    p_pre.warm_up(cmd,
+                                  {vk::Binding::sampled_image(0, r.source_cube.sampled_view, ctx.linear_sampler()),
+                                   vk::Binding::storage_image(1, r.prefiltered.storage_views[0])},
+                                  &pw, sizeof pw);
                     timer.begin(cmd, "prefilter_ggx");
                 }
                 // dst_size: the cube's face size, or a 2D layout level's width (its height follows).
                 const uint32_t w = std::max(1u, extent.width >> m), h = std::max(1u, extent.height >> m);
                 PrefilterPush pp{
-                    m, w, s.cube_size, s.prefilter_samples, float(r.full_mips),
-                    float(mips - 1), float(r.full_mips - 1)};
-                p_pre.dispatch(cmd, {vk::Binding::sampled_image(0, r.source_cube.sampled_view, ctx.linear_sampler()),
-                                     vk::Binding::storage_image(1, r.prefiltered.storage_views[m])},
+                    m, w, s.cube_size, s.prefilter_samples, float(r.full_mips), float(mips - 1), float(r.full_mips - 1)};
+                p_pre.dispatch(cmd,
+                               {vk::Binding::sampled_image(0, r.source_cube.sampled_view, ctx.linear_sampler()),
+                                vk::Binding::storage_image(1, r.prefiltered.storage_views[m])},
                                &pp, sizeof pp, groups(w), groups(h), extent.layers);
             }
             timer.end(cmd);
@@ -239,10 +250,10 @@ std::shared_ptr<IblResources> precompute_cached(GpuSession& gpu, const Environme
                                                 std::vector<PassTiming>& timings, bool& cached) {
     std::string key = "ibl;" + env.content_hash + ";" + std::to_string(s.cube_size) + ";" + std::to_string(s.mips) + ";" +
                       std::to_string(s.prefilter_samples) + ";" + s.mip_mapping + ";" + s.storage + ";" +
-                      std::to_string(s.rgbm_range) + ";" + s.astc_block + ";" + s.env_layout + ";" + std::to_string(s.prefiltered) + ";" + std::to_string(s.lut) +
-                      ";" + std::to_string(s.lut_size) + ";" + std::to_string(s.lut_samples) + ";" +
-                      std::to_string(s.irradiance_cube) + ";" + std::to_string(s.irradiance_size) + ";" +
-                      std::to_string(s.env_rotation_deg);
+                      std::to_string(s.rgbm_range) + ";" + s.astc_block + ";" + s.env_layout + ";" +
+                      std::to_string(s.prefiltered) + ";" + std::to_string(s.lut) + ";" + std::to_string(s.lut_size) + ";" +
+                      std::to_string(s.lut_samples) + ";" + std::to_string(s.irradiance_cube) + ";" +
+                      std::to_string(s.irradiance_size) + ";" + std::to_string(s.env_rotation_deg);
     // No shader hash in the key: the session's pipelines are cached by name and defines too, so a
     // session renders with the sources it first compiled either way.
     struct Entry {

@@ -12,8 +12,8 @@
 namespace iblcheck {
 
 struct PrecomputeSettings {
-    uint32_t cube_size = 128;        // base size of the cubes (64–512)
-    uint32_t mips = 7;               // levels of the prefiltered chain (the first seed's 7)
+    uint32_t cube_size = 128; // base size of the cubes (64–512)
+    uint32_t mips = 7;        // levels of the prefiltered chain (the first seed's 7)
     uint32_t prefilter_samples = 64;
     std::string mip_mapping = "ue4"; // ue4 | filament | origin
     std::string storage = "rgba16f"; // rgba16f | rgba32f | rgbm8 | r11g11b10 | astc_hdr | astc_ldr_rgbm
@@ -24,18 +24,18 @@ struct PrecomputeSettings {
     bool lut = false;                // env_brdf=lut
     uint32_t lut_size = 64;
     uint32_t lut_samples = 512;
-    bool irradiance_cube = false;    // diffuse=irradiance_cube
+    bool irradiance_cube = false; // diffuse=irradiance_cube
     uint32_t irradiance_size = 32;
     float env_rotation_deg = 0;
 };
 
 struct IblResources {
-    vk::Image source_cube;   // rgba32f, full box pyramid
-    vk::Image prefiltered;   // storage format (ASTC: its decoded texels, RGBA16F), `mips` levels, env_layout
-    vk::Buffer sh;           // 10 × vec4: SH9 of E/π, then the mean radiance
-    vk::Image lut;           // rg16f (1×1 placeholder when unused)
-    vk::Image irradiance;    // rgba32f cube (1×1 placeholder when unused)
-    uint32_t full_mips = 0;  // log2(cube_size) + 1
+    vk::Image source_cube;  // rgba32f, full box pyramid
+    vk::Image prefiltered;  // storage format (ASTC: its decoded texels, RGBA16F), `mips` levels, env_layout
+    vk::Buffer sh;          // 10 × vec4: SH9 of E/π, then the mean radiance
+    vk::Image lut;          // rg16f (1×1 placeholder when unused)
+    vk::Image irradiance;   // rgba32f cube (1×1 placeholder when unused)
+    uint32_t full_mips = 0; // log2(cube_size) + 1
     bool native_r11g11b10 = false;
     // The prefiltered chain as a device would store it: texels (borders of 2D layouts included)
     // and bytes in the storage format (ASTC: its blocks; r11g11b10: 4 bytes a texel even where
@@ -45,8 +45,8 @@ struct IblResources {
 };
 
 // Bytes of one w×h level of `layers` layers in the storage format.
-uint64_t storage_level_bytes(const std::string& storage, const std::string& astc_block, uint32_t width,
-                             uint32_t height, uint32_t layers);
+uint64_t storage_level_bytes(const std::string& storage, const std::string& astc_block, uint32_t width, uint32_t height,
+                             uint32_t layers);
 
 // Records and runs the precompute passes; appends their GPU timings (precompute = true).
 IblResources run_precompute(GpuSession& gpu, const Environment& env, const PrecomputeSettings& s,

@@ -3,15 +3,15 @@
 #include <chrono>
 #include <optional>
 
+#include "fragment_shading.h"
 #include "gpu_scene.h"
 #include "harness/common/errors.h"
+#include "ibl_precompute.h"
 #include "renderers/mobile/descriptor_types.h"
 #include "renderers/option_table.h"
-#include "ibl_precompute.h"
 #include "renderers/scenes/scene.h"
-#include "fragment_shading.h"
-#include "shading_cost.h"
 #include "renderers/vulkan/fp16_emulation.h"
+#include "shading_cost.h"
 
 namespace iblcheck {
 
@@ -51,9 +51,9 @@ RenderResult render_mobile(GpuSession& gpu, const Environment& env, const TestSp
     const IblResources& ibl = *ibl_ptr;
 
     vk::Defines defs = storage_defines(ps, ibl.native_r11g11b10);
-    defs.merge(glsl_defines(variant));  // keeps storage_defines' entries; adds the other selections
+    defs.merge(glsl_defines(variant)); // keeps storage_defines' entries; adds the other selections
     const bool fragment = variant.at("shading") == "fragment";
-    if (scene_uses_ao(scene)) defs["MATERIAL_AO"] = "1";  // scene.glsl: each sphere carries its AO
+    if (scene_uses_ao(scene)) defs["MATERIAL_AO"] = "1"; // scene.glsl: each sphere carries its AO
 
     vk::Context& ctx = gpu.ctx();
     vk::Buffer scene_buf = upload_scene(ctx, scene);
@@ -93,7 +93,8 @@ RenderResult render_mobile(GpuSession& gpu, const Environment& env, const TestSp
         result.texture_fetches_per_pixel = f.shaded_fragments_per_pixel * per_hit;
         instructions = f.instructions_per_pixel;
     } else {
-        const std::vector<VkDescriptorType> types = {kStorageBuffer, kSampled, kStorageBuffer, kSampled, kSampled, kStorageBuffer};
+        const std::vector<VkDescriptorType> types = {kStorageBuffer, kSampled, kStorageBuffer,
+                                                     kSampled,       kSampled, kStorageBuffer};
         const auto& shade = gpu.pipeline("shade_spheres.comp", defs, types, sizeof(ShadePush), shade_options);
         vk::Buffer out = ctx.create_buffer(VkDeviceSize(width) * height * 16);
         b.push_back(vk::Binding::storage_buffer(5, out));
@@ -110,7 +111,8 @@ RenderResult render_mobile(GpuSession& gpu, const Environment& env, const TestSp
         double coverage = read_back_image(out, width, height, result.image);
         // One shading per ray that hits.
         result.texture_fetches_per_pixel = coverage * pc.ssaa * pc.ssaa * per_hit;
-        instructions = shading_instructions_per_pixel(gpu, {"shade_spheres.comp", defs, types, shade_options, b, 5, &pc, sizeof pc, width, height}, out);
+        instructions = shading_instructions_per_pixel(
+            gpu, {"shade_spheres.comp", defs, types, shade_options, b, 5, &pc, sizeof pc, width, height}, out);
     }
     result.shader_instructions_per_pixel = instructions.value_or(0);
     result.texel_count = ibl.texel_count;
@@ -126,10 +128,11 @@ RenderResult render_mobile(GpuSession& gpu, const Environment& env, const TestSp
     if (fp16_path) result.provenance["fp16"] = vk::fp16_path_name(*fp16_path);
     if (fragment) {
         // What the cost counts differs from compute's: renderers/mobile/fragment_shading.h.
-        result.provenance["fragment"] = {{"msaa_samples", 4},
-                                         {"ssaa", pc.ssaa},
-                                         {"shaded_fragments_per_pixel", result.texture_fetches_per_pixel / per_hit},
-                                         {"instructions_counted", "vertex and fragment invocations; helper invocations excluded"}};
+        result.provenance["fragment"] = {
+            {"msaa_samples", 4},
+            {"ssaa", pc.ssaa},
+            {"shaded_fragments_per_pixel", result.texture_fetches_per_pixel / per_hit},
+            {"instructions_counted", "vertex and fragment invocations; helper invocations excluded"}};
     }
     return result;
 }

@@ -9,7 +9,7 @@ namespace iblcheck {
 
 // split_sum.glsl's Push (shade_spheres.comp and shade_spheres.frag, both paths of option shading).
 struct ShadePush {
-    uint32_t width, height;  // compute: the image; fragment: the framebuffer (image × ssaa)
+    uint32_t width, height; // compute: the image; fragment: the framebuffer (image × ssaa)
     uint32_t ssaa;
     float full_mips, max_lod, mix_begin, mix_end, mix_largest, indirect, aa_variance, aa_threshold, rot;
 };

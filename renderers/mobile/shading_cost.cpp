@@ -21,7 +21,7 @@ std::optional<double> shading_instructions_per_pixel(GpuSession& gpu, const Shad
                                                      uint32_t(pass.width + 7) / 8, uint32_t(pass.height + 7) / 8, 1);
     if (std::memcmp(scratch.mapped, out.mapped, size_t(out.size)) != 0)
         throw Error(pass.shader + ": the instruction-counting twin computed another image than the timed pass; "
-                    "its count would not describe the frame");
+                                  "its count would not describe the frame");
     return double(total) / (double(pass.width) * pass.height);
 }
 

@@ -14,15 +14,15 @@ namespace iblcheck {
 
 // A shading pass as the timed dispatch ran it.
 struct ShadingPass {
-    std::string shader;                      // "shade_spheres.comp"
+    std::string shader; // "shade_spheres.comp"
     vk::Defines defines;
     std::vector<VkDescriptorType> binding_types;
-    vk::CompileOptions options;              // as the timed pipeline was compiled (fp16 emulation)
+    vk::CompileOptions options; // as the timed pipeline was compiled (fp16 emulation)
     std::vector<vk::Binding> bindings;
-    uint32_t out_binding = 5;                // the vec4 image the pass writes
+    uint32_t out_binding = 5; // the vec4 image the pass writes
     const void* push = nullptr;
     uint32_t push_bytes = 0;
-    int width = 0, height = 0;               // image size; the dispatch is 8x8 workgroups over it
+    int width = 0, height = 0; // image size; the dispatch is 8x8 workgroups over it
 };
 
 // Dynamic SPIR-V instructions of the whole dispatch (every invocation, every ssaa ray) per image

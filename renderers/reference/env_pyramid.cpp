@@ -56,7 +56,8 @@ EnvPyramid::EnvPyramid(const Environment& env) {
     for (int j = 0; j < H_; ++j) texel_omega_[size_t(j)] = 2 * kPi / W_ * (row_z_[size_t(j)] - row_z_[size_t(j) + 1]);
     row_s_.resize(size_t(H_) + 1), col_s_.resize(size_t(W_) + 1), col_c_.resize(size_t(W_) + 1);
     for (int j = 0; j <= H_; ++j) row_s_[size_t(j)] = std::sin(j * kPi / H_);
-    for (int i = 0; i <= W_; ++i) col_s_[size_t(i)] = std::sin(phi_of(double(i) / W_)), col_c_[size_t(i)] = std::cos(phi_of(double(i) / W_));
+    for (int i = 0; i <= W_; ++i)
+        col_s_[size_t(i)] = std::sin(phi_of(double(i) / W_)), col_c_[size_t(i)] = std::cos(phi_of(double(i) / W_));
     taylor_ = 2 * kPi / W_ < 0.15 && kPi / H_ < 0.15; // series error < 0.15⁶/720 ≈ 2e-8
     sub_cos_.assign(16, std::vector<double>(size_t(H_)));
     for (int l = 0; l < 16; ++l)
@@ -191,7 +192,8 @@ void EnvPyramid::build_level(int k) {
     for (int j = 0; j < h; ++j)
         for (int i = 0; i < w; ++i) {
             EnvCell& c = out[size_t(j) * w + i];
-            double L[3] = {0, 0, 0}, cen[3] = {0, 0, 0}, wsum = 0, lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
+            double L[3] = {0, 0, 0}, cen[3] = {0, 0, 0}, wsum = 0, lo[3] = {1e300, 1e300, 1e300},
+                   hi[3] = {-1e300, -1e300, -1e300};
             for (int b = 0; b < 2; ++b)
                 for (int a = 0; a < 2; ++a) {
                     const int ii = 2 * i + a, jj = 2 * j + b;

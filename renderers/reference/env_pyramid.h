@@ -25,22 +25,22 @@
 namespace iblcheck::truth {
 
 struct EnvCell {
-    float L[3];        // ∫ L dω over the cell (RGB)
-    float c[3];        // luminance-weighted centroid direction (unit; the geometric centre if black)
-    float cov[6];      // luminance-weighted second moment of the directions about c (xx xy xz yy yz zz)
-    float mlen;        // |mean direction vector| (< 1): the mean vector is mlen·c
-    float sp[4][3];    // the quadrature rule's points (lobe_quadrature.h): c ± √2·l_k, l_k the columns of
-    int np;            // the Cholesky factor of cov on c's tangent plane; 1 point (c) when cov vanishes
-    float g[3];        // geometric centre direction (unit)
-    float cos_radius;  // cos of the largest angle from g to the cell's edge
-    float radius;      // that angle (acos of cos_radius, kept: the quadrature's guard compares angles)
+    float L[3];         // ∫ L dω over the cell (RGB)
+    float c[3];         // luminance-weighted centroid direction (unit; the geometric centre if black)
+    float cov[6];       // luminance-weighted second moment of the directions about c (xx xy xz yy yz zz)
+    float mlen;         // |mean direction vector| (< 1): the mean vector is mlen·c
+    float sp[4][3];     // the quadrature rule's points (lobe_quadrature.h): c ± √2·l_k, l_k the columns of
+    int np;             // the Cholesky factor of cov on c's tangent plane; 1 point (c) when cov vanishes
+    float g[3];         // geometric centre direction (unit)
+    float cos_radius;   // cos of the largest angle from g to the cell's edge
+    float radius;       // that angle (acos of cos_radius, kept: the quadrature's guard compares angles)
     float lo[3], hi[3]; // range of the bilinear radiance inside the cell (per channel)
 };
 
 class EnvPyramid {
   public:
     explicit EnvPyramid(const Environment& env);
-    int levels() const { return int(w_.size()); }   // level 0 .. levels() − 1
+    int levels() const { return int(w_.size()); } // level 0 .. levels() − 1
     int width(int level) const { return w_[size_t(level)]; }
     int height(int level) const { return h_[size_t(level)]; }
     const EnvCell& cell(int level, int i, int j) const { return cells_[size_t(level)][size_t(j) * w_[size_t(level)] + i]; }
@@ -96,13 +96,13 @@ class EnvPyramid {
     std::vector<float> data_; // the equirect, RGB rows
     std::vector<int> w_, h_;
     std::vector<std::vector<EnvCell>> cells_;
-    std::vector<double> texel_omega_, row_z_; // row_z_: cos θ at row edges (H + 1)
+    std::vector<double> texel_omega_, row_z_;   // row_z_: cos θ at row edges (H + 1)
     std::vector<double> row_s_, col_s_, col_c_; // sin θ at row edges; sin φ, cos φ at column edges
     std::vector<std::vector<double>> sub_cos_;  // [log2 n][row]: cos of subcell_radius
     // sin and cos of φ at fraction fu across texel column i, and of θ at fraction ft down texel row j.
     void phi_sc(int i, double fu, double& s, double& c) const;
     void theta_sc(int j, double ft, double& s, double& c) const;
-    bool taylor_ = true;                        // texels small enough for the angle-sum series
+    bool taylor_ = true; // texels small enough for the angle-sum series
 };
 
 } // namespace iblcheck::truth

@@ -131,34 +131,34 @@ TEST(EnvPyramid, SubcellsPartitionTheTexel) {
 // radiance in u and near-exact in θ, where sin θ varies). Texels on the seam (i = 0, u wraps) and the
 // poles (v clamps) included.
 TEST(EnvPyramid, SubcellGaussRuleMatchesTheFilterAndSumsToTheTexel) {
-  for (int W : {32, 128}) { // 32: the libm path; 128: texels small enough for the angle-sum series
-    const int H = W / 2;
-    Environment e = random_env(W, H, 9);
-    EnvPyramid p(e);
-    for (auto [i, j] : {std::pair{0, 0}, {W - 1, H - 1}, {7, 5}, {W / 2, H / 2}})
-        for (int n : {2, 4, 8}) {
-            double sum[3] = {0, 0, 0};
-            for (int b = 0; b < n; ++b)
-                for (int a = 0; a < n; ++a) {
-                    V3 dir[4];
-                    double wL[4][3];
-                    p.subcell_gauss(i, j, n, a, b, dir, wL);
-                    const double g = 0.5 / std::sqrt(3.0), w0 = 0.25 * (2 * kPi / (double(W) * n)) * (kPi / (double(H) * n));
-                    for (int k = 0; k < 4; ++k) {
-                        const double fu = (a + 0.5 + ((k & 1) ? g : -g)) / n, ft = (b + 0.5 + ((k >> 1) ? g : -g)) / n;
-                        double st, L[3];
-                        const V3 d = p.dir_in_texel(i, fu, j, ft, &st);
-                        bilinear_equirect(e.equirect.ptr<float>(0), W, H, size_t(W) * 3, (i + fu) / W, (j + ft) / H, L);
-                        EXPECT_NEAR(dot(d, dir[k]), 1.0, 1e-12);
-                        for (int q = 0; q < 3; ++q) {
-                            EXPECT_NEAR(wL[k][q], w0 * st * L[q], 1e-12 * (1 + std::fabs(w0 * st * L[q])));
-                            sum[q] += wL[k][q];
+    for (int W : {32, 128}) { // 32: the libm path; 128: texels small enough for the angle-sum series
+        const int H = W / 2;
+        Environment e = random_env(W, H, 9);
+        EnvPyramid p(e);
+        for (auto [i, j] : {std::pair{0, 0}, {W - 1, H - 1}, {7, 5}, {W / 2, H / 2}})
+            for (int n : {2, 4, 8}) {
+                double sum[3] = {0, 0, 0};
+                for (int b = 0; b < n; ++b)
+                    for (int a = 0; a < n; ++a) {
+                        V3 dir[4];
+                        double wL[4][3];
+                        p.subcell_gauss(i, j, n, a, b, dir, wL);
+                        const double g = 0.5 / std::sqrt(3.0), w0 = 0.25 * (2 * kPi / (double(W) * n)) * (kPi / (double(H) * n));
+                        for (int k = 0; k < 4; ++k) {
+                            const double fu = (a + 0.5 + ((k & 1) ? g : -g)) / n, ft = (b + 0.5 + ((k >> 1) ? g : -g)) / n;
+                            double st, L[3];
+                            const V3 d = p.dir_in_texel(i, fu, j, ft, &st);
+                            bilinear_equirect(e.equirect.ptr<float>(0), W, H, size_t(W) * 3, (i + fu) / W, (j + ft) / H, L);
+                            EXPECT_NEAR(dot(d, dir[k]), 1.0, 1e-12);
+                            for (int q = 0; q < 3; ++q) {
+                                EXPECT_NEAR(wL[k][q], w0 * st * L[q], 1e-12 * (1 + std::fabs(w0 * st * L[q])));
+                                sum[q] += wL[k][q];
+                            }
                         }
                     }
-                }
-            for (int q = 0; q < 3; ++q) EXPECT_NEAR(sum[q] / p.cell(0, i, j).L[q], 1.0, 1e-3) << i << "," << j << " n=" << n;
-        }
-  }
+                for (int q = 0; q < 3; ++q) EXPECT_NEAR(sum[q] / p.cell(0, i, j).L[q], 1.0, 1e-3) << i << "," << j << " n=" << n;
+            }
+    }
 }
 
 // radiance_range bounds the bilinear radiance over a cone (random cones and directions inside them).

@@ -16,7 +16,9 @@ namespace {
 struct Quadrant {
     double area, mx, my;
 };
-double S(double x, double r) { return 0.5 * (x * std::sqrt(std::max(0.0, r * r - x * x)) + r * r * std::asin(std::clamp(x / r, -1.0, 1.0))); }
+double S(double x, double r) {
+    return 0.5 * (x * std::sqrt(std::max(0.0, r * r - x * x)) + r * r * std::asin(std::clamp(x / r, -1.0, 1.0)));
+}
 double T(double x, double r) { return std::pow(std::max(0.0, r * r - x * x), 1.5) / 3; }
 double P(double a, double b, double r) {
     a = std::min(a, r), b = std::min(b, r);

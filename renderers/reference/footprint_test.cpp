@@ -19,7 +19,8 @@ double brute_area(const Disc& d, double x0, double y0, double x1, double y1, dou
     for (int j = 0; j < n; ++j)
         for (int i = 0; i < n; ++i) {
             const double x = x0 + (i + 0.5) * dx, y = y0 + (j + 0.5) * dy;
-            if ((x - d.cx) * (x - d.cx) + (y - d.cy) * (y - d.cy) <= d.r * d.r) a += dx * dy, sx += x * dx * dy, sy += y * dx * dy;
+            if ((x - d.cx) * (x - d.cx) + (y - d.cy) * (y - d.cy) <= d.r * d.r)
+                a += dx * dy, sx += x * dx * dy, sy += y * dx * dy;
         }
     mx = a > 0 ? sx / a : 0, my = a > 0 ? sy / a : 0;
     return a;

@@ -51,9 +51,8 @@ double clip_above_horizon(const EnvPyramid::Rect& r, V3 n, V3& centroid) {
 // horizon is a max(0, ·) mask), so the compiler vectorises it; GCC's target_clones adds an AVX2+FMA
 // version picked at run time on machines that have it (the results differ from the default version's
 // in the last bits; each is deterministic).
-__attribute__((target_clones("arch=haswell", "default"))) void fcos4(const MaterialLobe& L, const ShadingPoint& s,
-                                                                      const double* lx, const double* ly,
-                                                                      const double* lz, double out[3][4]) {
+__attribute__((target_clones("arch=haswell", "default"))) void
+fcos4(const MaterialLobe& L, const ShadingPoint& s, const double* lx, const double* ly, const double* lz, double out[3][4]) {
     double nl[4];
     for (int k = 0; k < 4; ++k) nl[k] = std::max(0.0, s.n.x * lx[k] + s.n.y * ly[k] + s.n.z * lz[k]);
     for (int q = 0; q < 3; ++q)
@@ -93,9 +92,9 @@ struct Integrand {
     const MaterialLobe& lobe;
     const ShadingPoint& s;
     const QuadratureParams& p;
-    V3 peak;              // mirror direction: the GGX lobe's core
-    double cos_guard_w;   // cos(κ·w)
-    double w;             // the lobe's width
+    V3 peak;            // mirror direction: the GGX lobe's core
+    double cos_guard_w; // cos(κ·w)
+    double w;           // the lobe's width
     bool guard;
     long evals = 0;
 
@@ -128,7 +127,7 @@ struct Integrand {
         }
         const double sr = std::sqrt(std::max(0.0, 1 - cr * cr)), h = dot(g, s.n);
         if (h < -sr) return false; // angle to n > 90° + radius
-        if (h < sr) { // straddles the horizon
+        if (h < sr) {              // straddles the horizon
             V3 c;
             const double frac = clip_above_horizon(env.rect(level, i, j, a, b), s.n, c);
             if (frac <= 0) return false;
@@ -197,7 +196,8 @@ struct Integrand {
             for (int db = 0; db < 2; ++db)
                 for (int da = 0; da < 2; ++da) {
                     int* k = out[n++];
-                    k[0] = level - 1, k[1] = i, k[2] = j, k[3] = level == 0 ? da : 2 * a + da, k[4] = level == 0 ? db : 2 * b + db;
+                    k[0] = level - 1, k[1] = i, k[2] = j, k[3] = level == 0 ? da : 2 * a + da,
+                    k[4] = level == 0 ? db : 2 * b + db;
                 }
         }
     }

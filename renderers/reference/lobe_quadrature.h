@@ -29,7 +29,7 @@ struct QuadratureParams {
 struct ShadeStats {
     long evaluations = 0; // BRDF evaluations
     long splits = 0;
-    double error = 0;     // Σ indicators (absolute, rgb_size)
+    double error = 0; // Σ indicators (absolute, rgb_size)
     bool budget_hit = false;
 };
 

@@ -6,9 +6,9 @@
 
 #include <algorithm>
 #include <atomic>
-#include <filesystem>
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <thread>
 
 #include <fmt/format.h>
@@ -42,8 +42,7 @@ struct EnvImage {
     const float* data = nullptr;
     int W = 0, H = 0;
     size_t stride = 0; // floats per row
-    explicit EnvImage(const cv::Mat& m)
-        : data(m.ptr<float>(0)), W(m.cols), H(m.rows), stride(m.step1()) {}
+    explicit EnvImage(const cv::Mat& m) : data(m.ptr<float>(0)), W(m.cols), H(m.rows), stride(m.step1()) {}
     void lookup(double u, double v, double rgb[3]) const { bilinear_equirect(data, W, H, stride, u, v, rgb); }
 };
 
@@ -51,8 +50,8 @@ struct Shader {
     const EnvImage& img;
     const EnvDistribution& dist;
     Lobes lobes;
-    bool power = true;   // MIS heuristic: power (β = 2) or balance
-    bool window = true;  // env_sampling = window (EnvWindow) or global
+    bool power = true;  // MIS heuristic: power (β = 2) or balance
+    bool window = true; // env_sampling = window (EnvWindow) or global
 };
 
 // Per-sphere constants of the model.
@@ -166,8 +165,10 @@ void shade(const Shader& S, const MatConst& M, const EnvWindow& win, V3 n, V3 v,
     if (!want_diff && !cont_spec) return;
 
     double p_s;
-    if (!want_diff) p_s = 1;
-    else if (!cont_spec) p_s = 0;
+    if (!want_diff)
+        p_s = 1;
+    else if (!cont_spec)
+        p_s = 0;
     else {
         double sw = 0;
         for (int i = 0; i < 3; ++i) sw += model::f_schlick(M.f0[i], nv);
@@ -242,7 +243,8 @@ void shade(const Shader& S, const MatConst& M, const EnvWindow& win, V3 n, V3 v,
     if (!S.dist.empty()) {
         double e0, e1, dw[3], u, vv, pe = 0;
         reference::sobol_owen_2d(k, seeds.env, e0, e1);
-        if (!win.valid) pe = S.dist.sample_uv(e0, e1, dw, u, vv);
+        if (!win.valid)
+            pe = S.dist.sample_uv(e0, e1, dw, u, vv);
         else {
             // Mixture: e1 < ε picks the global distribution, else the window (e1 rescaled, as for the lobes).
             double pg;
@@ -296,8 +298,8 @@ std::string estimator_description(bool window, bool lobe_window, double compensa
     return "sub-pixel positions: an Owen-scrambled Sobol pattern per pixel keyed by pixel_pattern (not by the "
            "lighting seed); lighting per position: MIS (power heuristic, 1 sample each) of "
            "BRDF sampling [mixture of GGX VNDF (Heitz 2018) with p_s = F/(F+diffuse) clamped to [0.1,0.9], and "
-           "cosine hemisphere] and " + env +
-           ", whole BRDF per sample; adaptive lighting-sample counts from a discarded pilot, silhouette pixels at least " +
+           "cosine hemisphere] and " +
+           env + ", whole BRDF per sample; adaptive lighting-sample counts from a discarded pilot, silhouette pixels at least " +
            std::to_string(silhouette_boost) +
            "x the mean; alpha < 1e-4 treated as a mirror delta F(n.v) L(reflect); bilinear env lookups; no "
            "inter-sphere occlusion";
@@ -335,7 +337,8 @@ void pixel_candidates(const Scene& scene, int W, int H, int x, int y, std::vecto
             cand = dist <= r + slack;
         } else {
             double D = std::sqrt(cc);
-            if (D <= r) cand = true;
+            if (D <= r)
+                cand = true;
             else {
                 double ang = std::acos(std::clamp(along / D, -1.0, 1.0));
                 cand = ang <= std::asin(std::min(1.0, r / D)) + slack;
@@ -346,8 +349,7 @@ void pixel_candidates(const Scene& scene, int W, int H, int x, int y, std::vecto
 }
 
 // Nearest hit among the candidate spheres: the arithmetic of scene.cpp's intersect().
-bool intersect_candidates(const Scene& scene, const std::vector<int>& cand, Vec3f origin, Vec3f dir, int& sphere,
-                          V3& normal) {
+bool intersect_candidates(const Scene& scene, const std::vector<int>& cand, Vec3f origin, Vec3f dir, int& sphere, V3& normal) {
     double best_t = INFINITY;
     sphere = -1;
     for (int i : cand) {
@@ -695,16 +697,17 @@ ReferenceRender render_reference_full(const TestSpec& spec, const Environment* e
         {"env_sampling", env_sampling},
         {"env_window", env_window},
         {"mis_compensation", mis_compensation},
-        {"env", {{"spec", env.spec.empty() ? spec.env : env.spec},
-                 {"content_hash", env.content_hash},
-                 // the file's name, not its path: provenance holds no machine paths (issue 15)
-                 {"source_file", std::filesystem::path(env.source_path).filename().string()},
-                 {"width", env.equirect.cols},
-                 {"height", env.equirect.rows},
-                 {"negatives_clamped", env.negatives_clamped},
-                 {"rotation_deg", env.rotation_deg}}},
+        {"env",
+         {{"spec", env.spec.empty() ? spec.env : env.spec},
+          {"content_hash", env.content_hash},
+          // the file's name, not its path: provenance holds no machine paths (issue 15)
+          {"source_file", std::filesystem::path(env.source_path).filename().string()},
+          {"width", env.equirect.cols},
+          {"height", env.equirect.rows},
+          {"negatives_clamped", env.negatives_clamped},
+          {"rotation_deg", env.rotation_deg}}},
         {"estimator", estimator_description(env_sampling == "window", env_window == "lobe", mis_compensation,
-                                             adaptive ? silhouette_boost : 1)},
+                                            adaptive ? silhouette_boost : 1)},
         {"texture_fetches_per_pixel", r.texture_fetches_per_pixel},
         {"time_s", total_s},
     };

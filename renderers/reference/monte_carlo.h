@@ -156,10 +156,10 @@ class EnvDistribution {
     int cells_x() const { return cw_; }
     int cells_y() const { return ch_; }
     int cell_of_uv(double u, double v) const;
-    double cell_mass(int c) const { return cell_mass_[size_t(c)]; } // W_c / total, sums to 1
+    double cell_mass(int c) const { return cell_mass_[size_t(c)]; }              // W_c / total, sums to 1
     const double* cell_centre(int c) const { return &cell_dir_[size_t(c) * 3]; } // world direction
     double cell_solid_angle(int c) const { return cell_omega_[size_t(c)]; }
-    double cell_radius(int c) const { return cell_rad_[size_t(c)]; } // angular radius (rad)
+    double cell_radius(int c) const { return cell_rad_[size_t(c)]; }         // angular radius (rad)
     double cell_cos_radius(int c) const { return cell_cos_rad_[size_t(c)]; } // cos of its angular radius
     double cell_sin_radius(int c) const { return cell_sin_rad_[size_t(c)]; }
     // Samples a pixel of cell c from (u1, u2) (u2 picks the row, u1 the column); returns pdf(ω), the
@@ -170,15 +170,15 @@ class EnvDistribution {
     double place(int i, int j, double du, double dv, double dir[3], double& u, double& v) const;
     void env_to_world(const double e[3], double d[3]) const;
     int w_ = 0, h_ = 0;
-    int cw_ = 0, ch_ = 0;                 // cells
-    std::vector<int> cell_i0_, cell_j0_;  // cw_ + 1, ch_ + 1 pixel bounds
-    std::vector<double> cell_mass_;       // cw_ * ch_, fraction of total
-    std::vector<double> cell_dir_;        // cw_ * ch_ * 3
+    int cw_ = 0, ch_ = 0;                // cells
+    std::vector<int> cell_i0_, cell_j0_; // cw_ + 1, ch_ + 1 pixel bounds
+    std::vector<double> cell_mass_;      // cw_ * ch_, fraction of total
+    std::vector<double> cell_dir_;       // cw_ * ch_ * 3
     std::vector<double> cell_rad_, cell_cos_rad_, cell_sin_rad_, cell_omega_;
-    std::vector<double> cell_row_cdf_;    // per cell: CDF over its pixel rows of the row masses within the cell
-    std::vector<size_t> cell_row_off_;    // offset of each cell's CDF (rows + 1 entries)
+    std::vector<double> cell_row_cdf_; // per cell: CDF over its pixel rows of the row masses within the cell
+    std::vector<size_t> cell_row_off_; // offset of each cell's CDF (rows + 1 entries)
     double total_ = 0;
-    double rot_c_ = 1, rot_s_ = 0; // env -> world rotation by +rotation_deg about +Y
+    double rot_c_ = 1, rot_s_ = 0;        // env -> world rotation by +rotation_deg about +Y
     std::vector<double> marginal_cdf_;    // h_ + 1
     std::vector<double> conditional_cdf_; // h_ * (w_ + 1)
     std::vector<int> marginal_guide_;     // h_ (cutpoint guide table)
@@ -194,8 +194,10 @@ inline int search_cdf(const double* cdf, int lo, int hi, double t) {
     int a = lo, b = hi - 1;
     while (a < b) {
         int m = (a + b + 1) / 2;
-        if (cdf[m] <= t) a = m;
-        else b = m - 1;
+        if (cdf[m] <= t)
+            a = m;
+        else
+            b = m - 1;
     }
     while (a > lo && cdf[a + 1] - cdf[a] <= 0) --a;
     return a;

@@ -74,8 +74,8 @@ struct NormalTable::Builder {
     }
 
     // Fills tree[slot] for the cell (x0, y0, s) with corner values c00, c10, c01, c11.
-    void build(std::vector<Cell>& tree, int slot, double x0, double y0, double s, int depth, const float* c00,
-               const float* c10, const float* c01, const float* c11) {
+    void build(std::vector<Cell>& tree, int slot, double x0, double y0, double s, int depth, const float* c00, const float* c10,
+               const float* c01, const float* c11) {
         float g[9][3];
         for (int q = 0; q < 3; ++q) g[0][q] = c00[q], g[2][q] = c10[q], g[6][q] = c01[q], g[8][q] = c11[q];
         const double h = s / 2;
@@ -92,7 +92,8 @@ struct NormalTable::Builder {
             for (const auto& m : mids) {
                 double d[3], a[3];
                 for (int q = 0; q < 3; ++q) {
-                    const double pred = m[1] >= 0 ? 0.5 * (g[m[1]][q] + g[m[2]][q]) : 0.25 * (g[0][q] + g[2][q] + g[6][q] + g[8][q]);
+                    const double pred =
+                        m[1] >= 0 ? 0.5 * (g[m[1]][q] + g[m[2]][q]) : 0.25 * (g[0][q] + g[2][q] + g[6][q] + g[8][q]);
                     d[q] = g[m[0]][q] - pred, a[q] = g[m[0]][q];
                 }
                 err = std::max(err, rgb_size(d) / (rgb_size(a) + floor_));
@@ -136,7 +137,8 @@ struct NormalTable::Builder {
         for (int q = 0; q < 3; ++q) {
             c.lo[q] = tree[size_t(first)].lo[q], c.hi[q] = tree[size_t(first)].hi[q];
             for (int k = 1; k < 4; ++k)
-                c.lo[q] = std::min(c.lo[q], tree[size_t(first + k)].lo[q]), c.hi[q] = std::max(c.hi[q], tree[size_t(first + k)].hi[q]);
+                c.lo[q] = std::min(c.lo[q], tree[size_t(first + k)].lo[q]),
+                c.hi[q] = std::max(c.hi[q], tree[size_t(first + k)].hi[q]);
         }
     }
 };
@@ -186,7 +188,8 @@ NormalTable::NormalTable(const EnvPyramid& env, const MaterialLobe& lobe, V3 v, 
                 std::vector<Cell>& tree = trees_[size_t(k)];
                 tree.resize(1);
                 auto node = [&](int a, int c) { return &grid[(size_t(j + c) * (n_ + 1) + i + a) * 3]; };
-                b.build(tree, 0, x0_ + i * coarse_, x0_ + j * coarse_, coarse_, 0, node(0, 0), node(1, 0), node(0, 1), node(1, 1));
+                b.build(tree, 0, x0_ + i * coarse_, x0_ + j * coarse_, coarse_, 0, node(0, 0), node(1, 0), node(0, 1),
+                        node(1, 1));
             }
             const int d = ++done;
             if (progress) {
@@ -230,9 +233,7 @@ void NormalTable::lookup(V3 n, double rgb[3]) const {
         return;
     }
     // Biquadratic (Lagrange) on the leaf's 3x3 grid: nodes at t = 0, 1/2, 1.
-    auto basis = [](double t, double w[3]) {
-        w[0] = (2 * t - 1) * (t - 1), w[1] = 4 * t * (1 - t), w[2] = t * (2 * t - 1);
-    };
+    auto basis = [](double t, double w[3]) { w[0] = (2 * t - 1) * (t - 1), w[1] = 4 * t * (1 - t), w[2] = t * (2 * t - 1); };
     double wx[3], wy[3];
     basis(fx, wx), basis(fy, wy);
     rgb[0] = rgb[1] = rgb[2] = 0;
@@ -243,8 +244,8 @@ void NormalTable::lookup(V3 n, double rgb[3]) const {
         }
 }
 
-void NormalTable::range(size_t tree, int cell, double x0, double y0, double s, double bx0, double by0, double bx1,
-                        double by1, double lo[3], double hi[3]) const {
+void NormalTable::range(size_t tree, int cell, double x0, double y0, double s, double bx0, double by0, double bx1, double by1,
+                        double lo[3], double hi[3]) const {
     if (x0 > bx1 || x0 + s < bx0 || y0 > by1 || y0 + s < by0) return;
     const Cell& c = trees_[tree][size_t(cell)];
     const bool inside = x0 >= bx0 && x0 + s <= bx1 && y0 >= by0 && y0 + s <= by1;
@@ -263,8 +264,10 @@ double NormalTable::variation(V3 n, double radius) const {
     // `radius` lies inside a box of half-size 2·radius.
     const double e = 2 * radius + 1e-9;
     double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
-    const int i0 = std::clamp(int(std::floor((X - e - x0_) / coarse_)), 0, n_ - 1), i1 = std::clamp(int(std::floor((X + e - x0_) / coarse_)), 0, n_ - 1);
-    const int j0 = std::clamp(int(std::floor((Y - e - x0_) / coarse_)), 0, n_ - 1), j1 = std::clamp(int(std::floor((Y + e - x0_) / coarse_)), 0, n_ - 1);
+    const int i0 = std::clamp(int(std::floor((X - e - x0_) / coarse_)), 0, n_ - 1),
+              i1 = std::clamp(int(std::floor((X + e - x0_) / coarse_)), 0, n_ - 1);
+    const int j0 = std::clamp(int(std::floor((Y - e - x0_) / coarse_)), 0, n_ - 1),
+              j1 = std::clamp(int(std::floor((Y + e - x0_) / coarse_)), 0, n_ - 1);
     for (int j = j0; j <= j1; ++j)
         for (int i = i0; i <= i1; ++i) {
             const size_t k = size_t(j) * n_ + i;

@@ -26,14 +26,14 @@
 namespace iblcheck::truth {
 
 struct TableParams {
-    double coarse = 1.0 / 8;   // coarse cell size (equal-area units, ≈ radians at n = v)
-    double tolerance = 1e-3;   // relative interpolation error that splits a cell
-    double floor = 0;          // absolute radiance added to |value| in the tolerance
-    int max_depth = 8;         // cells down to coarse / 2^max_depth
-    double kappa = 1;          // forced while the cell is wider than κ·α
-    double min_nv = 0;         // the table covers n·v ≥ min_nv (−0.5 for bump normals)
-    double weight_offset = 0;  // errors weigh by clamp(n·v + offset, 0.02, 1) (the image area; bumps: 0.3)
-    double footprint = 0;      // a pixel's size in normal space: smaller cells are tested on their integral
+    double coarse = 1.0 / 8;  // coarse cell size (equal-area units, ≈ radians at n = v)
+    double tolerance = 1e-3;  // relative interpolation error that splits a cell
+    double floor = 0;         // absolute radiance added to |value| in the tolerance
+    int max_depth = 8;        // cells down to coarse / 2^max_depth
+    double kappa = 1;         // forced while the cell is wider than κ·α
+    double min_nv = 0;        // the table covers n·v ≥ min_nv (−0.5 for bump normals)
+    double weight_offset = 0; // errors weigh by clamp(n·v + offset, 0.02, 1) (the image area; bumps: 0.3)
+    double footprint = 0;     // a pixel's size in normal space: smaller cells are tested on their integral
 };
 
 class NormalTable {
@@ -44,8 +44,8 @@ class NormalTable {
     void lookup(V3 n, double rgb[3]) const;
     // Bound on the range (rgb_size of hi − lo) of lookup() over the normals within `radius` of n.
     double variation(V3 n, double radius) const;
-    long nodes() const { return nodes_; }          // shading points evaluated
-    long evaluations() const { return evals_; }    // BRDF evaluations in them
+    long nodes() const { return nodes_; }       // shading points evaluated
+    long evaluations() const { return evals_; } // BRDF evaluations in them
     long leaves() const;
     // The map and its inverse (exposed for tests).
     void to_map(V3 n, double& X, double& Y) const;
@@ -63,7 +63,7 @@ class NormalTable {
                double lo[3], double hi[3]) const;
     V3 v_, r_, u_;
     double x0_ = 0, coarse_ = 0;
-    int n_ = 0;                           // coarse cells per side
+    int n_ = 0;                            // coarse cells per side
     std::vector<std::vector<Cell>> trees_; // per coarse cell (row-major), root at index 0
     long nodes_ = 0, evals_ = 0;
 };

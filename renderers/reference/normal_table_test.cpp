@@ -21,7 +21,8 @@ TEST(NormalTable, EqualAreaMapRoundTrips) {
     const MaterialLobe L = lobe_of(1, 0);
     TableParams tp;
     tp.coarse = 0.5, tp.max_depth = 0;
-    const V3 v = normalize(V3{0.2, 0.1, 1}), r = normalize(V3{1, 0, -0.2}), u{v.y * r.z - v.z * r.y, v.z * r.x - v.x * r.z, v.x * r.y - v.y * r.x};
+    const V3 v = normalize(V3{0.2, 0.1, 1}), r = normalize(V3{1, 0, -0.2}),
+             u{v.y * r.z - v.z * r.y, v.z * r.x - v.x * r.z, v.x * r.y - v.y * r.x};
     NormalTable t(env, L, v, r, u, tp, QuadratureParams{}, 1);
     std::mt19937 rng(2);
     std::uniform_real_distribution<double> q(-1, 1);
@@ -64,8 +65,8 @@ TEST(NormalTable, LookupsMatchDirectQuadrature) {
         }
         mean /= n;
         EXPECT_LT(mean, tol) << "roughness " << rough;
-        std::printf("table r=%.1f m=%.0f: %ld nodes, lookup vs quadrature: mean %.2e worst %.2e\n", rough, metal, t.nodes(),
-                    mean, worst);
+        std::printf("table r=%.1f m=%.0f: %ld nodes, lookup vs quadrature: mean %.2e worst %.2e\n", rough, metal, t.nodes(), mean,
+                    worst);
     }
 }
 

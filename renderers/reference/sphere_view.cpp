@@ -101,7 +101,8 @@ double SphereView::mirror_variation(const EnvPyramid& env, double x0, double y0,
 
 std::vector<SphereView> sphere_views(const Scene& scene, int W, int H, Lobes lobes) {
     if (!scene.camera.orthographic)
-        throw UsageError("scene " + scene.name + ": the quadrature truth needs the orthographic camera (a constant view per sphere)");
+        throw UsageError("scene " + scene.name +
+                         ": the quadrature truth needs the orthographic camera (a constant view per sphere)");
     std::vector<SphereView> v;
     for (size_t i = 0; i < scene.spheres.size(); ++i) v.emplace_back(scene, int(i), W, H, lobes);
     for (size_t i = 0; i < v.size(); ++i)

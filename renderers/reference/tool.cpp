@@ -9,8 +9,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <ctime>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 
@@ -21,7 +21,6 @@
 #include "renderers/reference/truth_golden.h"
 
 using namespace iblcheck;
-
 
 // --truth: the quadrature truth (truth_golden.h): golden + sidecar; --compare OLD.exr prints the mean FLIP
 // and relative RMSE between the new golden and OLD (the check against the committed golden).
@@ -78,8 +77,10 @@ static int run_diff(const std::string& a_path, const std::string& b_path, int ti
             for (int y = 0; y < a.rows; ++y)
                 for (int x = 0; x < a.cols; ++x) {
                     const double c = truth::disc_rect_area(sv.disc(), x, y, x + 1, y + 1);
-                    if (c >= 1 - 1e-9) full.at<float>(y, x) = 1;
-                    else if (c > 0) part.at<float>(y, x) = 1;
+                    if (c >= 1 - 1e-9)
+                        full.at<float>(y, x) = 1;
+                    else if (c > 0)
+                        part.at<float>(y, x) = 1;
                 }
         std::printf("  fully covered pixels (%d): mean FLIP %.5f, relative RMSE %.4f%%; silhouette pixels (%d): mean FLIP "
                     "%.5f, relative RMSE %.4f%%\n",
@@ -102,8 +103,8 @@ static int run_diff(const std::string& a_path, const std::string& b_path, int ti
                         if (t > worst) worst = t, wx = x, wy = y;
                     }
                 }
-            std::printf("  tile %3d,%3d: FLIP %.5f  rel %.4f%%  worst %.4f (%d,%d)\n", tx, ty, cv::mean(fr.errmap(rc), cov(rc) > 0)[0],
-                        100 * relative_rmse(a(rc), b(rc), cov(rc)), worst, wx, wy);
+            std::printf("  tile %3d,%3d: FLIP %.5f  rel %.4f%%  worst %.4f (%d,%d)\n", tx, ty,
+                        cv::mean(fr.errmap(rc), cov(rc) > 0)[0], 100 * relative_rmse(a(rc), b(rc), cov(rc)), worst, wx, wy);
         }
     }
     return 0;
@@ -142,31 +143,45 @@ int main(int argc, char** argv) {
                 if (i + 1 >= argc) throw UsageError(a + " needs a value");
                 return argv[++i];
             };
-            if (a == "--scene") spec.scene = next();
-            else if (a == "--env") spec.env = next();
-            else if (a == "--spp") spec.options.set("spp", next());
-            else if (a == "--seed") spec.options.set("seed", next());
-            else if (a == "--threads") spec.options.set("threads", next());
-            else if (a == "--width") spec.width = std::stoi(next());
-            else if (a == "--height") spec.height = std::stoi(next());
-            else if (a == "--set") spec.options.set_from_string(next());
-            else if (a == "--out") out_path = next();
-            else if (a == "--meta") meta_path = next();
-            else if (a == "--noise-floor") noise = true;
-            else if (a == "--command") command = next();
-            else if (a == "--truth") truth = true;
-            else if (a == "--frames") frames = std::stoi(next());
-            else if (a == "--compare") compare_path = next();
+            if (a == "--scene")
+                spec.scene = next();
+            else if (a == "--env")
+                spec.env = next();
+            else if (a == "--spp")
+                spec.options.set("spp", next());
+            else if (a == "--seed")
+                spec.options.set("seed", next());
+            else if (a == "--threads")
+                spec.options.set("threads", next());
+            else if (a == "--width")
+                spec.width = std::stoi(next());
+            else if (a == "--height")
+                spec.height = std::stoi(next());
+            else if (a == "--set")
+                spec.options.set_from_string(next());
+            else if (a == "--out")
+                out_path = next();
+            else if (a == "--meta")
+                meta_path = next();
+            else if (a == "--noise-floor")
+                noise = true;
+            else if (a == "--command")
+                command = next();
+            else if (a == "--truth")
+                truth = true;
+            else if (a == "--frames")
+                frames = std::stoi(next());
+            else if (a == "--compare")
+                compare_path = next();
             else if (a == "--diff") {
                 diff_a = next();
                 diff_b = next();
-            }
-            else if (a == "--tiles") {
+            } else if (a == "--tiles") {
                 std::string t = next();
                 if (std::sscanf(t.c_str(), "%dx%d", &tile_w, &tile_h) != 2 || tile_w < 1 || tile_h < 1)
                     throw UsageError("--tiles: expected WxH, e.g. 48x48, got '" + t + "'");
-            }
-            else throw UsageError("unknown argument '" + a + "' (see the comment at the top of tool.cpp)");
+            } else
+                throw UsageError("unknown argument '" + a + "' (see the comment at the top of tool.cpp)");
         }
         if (!diff_a.empty()) return run_diff(diff_a, diff_b, tile_w, tile_h, spec);
         if (out_path.empty()) throw UsageError("--out FILE.exr is required");
@@ -188,8 +203,9 @@ int main(int argc, char** argv) {
                                    {"covered_pixels", nf.covered_pixels},
                                    {"seeds", {nf.seed_a, nf.seed_b}},
                                    {"mean_flip", fr.mean},
-                                   {"what_differs", "the lighting random numbers only: both renders integrate each pixel's "
-                                                    "footprint with the same sub-pixel pattern (pixel_pattern), see reference.h"}};
+                                   {"what_differs",
+                                    "the lighting random numbers only: both renders integrate each pixel's "
+                                    "footprint with the same sub-pixel pattern (pixel_pattern), see reference.h"}};
             // Issue 5's convergence criterion, stated with its verdict.
             const double flip = fr.mean;
             meta["noise_floor"]["criterion"] = {{"mean_flip_below", 0.002},
@@ -238,8 +254,7 @@ int main(int argc, char** argv) {
         meta["options"] = spec.options.canonical();
         meta["width"] = image.cols;
         meta["height"] = image.rows;
-        meta["env"] = {{"spec", spec.env}, {"content_hash", env.content_hash},
-                       {"negatives_clamped", env.negatives_clamped}};
+        meta["env"] = {{"spec", spec.env}, {"content_hash", env.content_hash}, {"negatives_clamped", env.negatives_clamped}};
         meta["spp"] = spp;
         meta["time_s"] = time_s;
         meta["command"] = command;
@@ -252,8 +267,7 @@ int main(int argc, char** argv) {
                              std::filesystem::path(out_path).replace_extension(".json").string() + ")");
         truth::write_golden_files(out_path, image, meta);
         std::printf("%s: %dx%d spp=%d time=%.1fs%s\n", out_path.c_str(), image.cols, image.rows, spp, time_s,
-                    noise ? (" noise_floor=" + std::to_string(meta["noise_floor"]["relative_rmse"].get<double>())).c_str()
-                          : "");
+                    noise ? (" noise_floor=" + std::to_string(meta["noise_floor"]["relative_rmse"].get<double>())).c_str() : "");
         return 0;
     } catch (const UsageError& e) {
         std::cerr << "iblcheck_reference_tool: " << e.what() << "\n";

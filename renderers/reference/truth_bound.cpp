@@ -57,14 +57,15 @@ TruthBound compare_levels(const TruthImage& coarse, const TruthImage& fine, cons
 nlohmann::json TruthBound::json() const {
     nlohmann::json s = nlohmann::json::array();
     for (const SphereBound& p : spheres)
-        s.push_back({{"label", p.label}, {"pixels", p.pixels}, {"relative_rmse", p.relative_rmse}, {"worst_pixel", p.worst},
-                     {"worst_pixel_relative", p.worst_relative}, {"worst_pixel_xy", {p.worst_x, p.worst_y}}});
-    return {{"relative_rmse", relative_rmse},
-            {"worst_pixel", worst},
-            {"worst_pixel_relative", worst_relative},
-            {"worst_pixel_xy", {worst_x, worst_y}},
-            {"covered_pixels", covered_pixels},
-            {"per_sphere", s}};
+        s.push_back({{"label", p.label},
+                     {"pixels", p.pixels},
+                     {"relative_rmse", p.relative_rmse},
+                     {"worst_pixel", p.worst},
+                     {"worst_pixel_relative", p.worst_relative},
+                     {"worst_pixel_xy", {p.worst_x, p.worst_y}}});
+    return {{"relative_rmse", relative_rmse},         {"worst_pixel", worst},
+            {"worst_pixel_relative", worst_relative}, {"worst_pixel_xy", {worst_x, worst_y}},
+            {"covered_pixels", covered_pixels},       {"per_sphere", s}};
 }
 
 } // namespace iblcheck::truth

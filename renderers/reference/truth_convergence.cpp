@@ -11,8 +11,8 @@
 #include <sys/resource.h>
 
 #include <chrono>
-#include <cstdlib>
 #include <cstdio>
+#include <cstdlib>
 #include <iostream>
 #include <sstream>
 
@@ -40,13 +40,20 @@ TruthAccuracy parse_level(const std::string& text) {
         if (eq == std::string::npos) throw UsageError("--level: expected key=value, got '" + kv + "'");
         const std::string k = kv.substr(0, eq);
         const double v = std::stod(kv.substr(eq + 1));
-        if (k == "pixel") a.pixel_tolerance = v;
-        else if (k == "env") a.env_tolerance = v;
-        else if (k == "table") a.table_tolerance = v;
-        else if (k == "kappa") a.kappa = v;
-        else if (k == "floor") a.floor = v;
-        else if (k == "bound") a.bound_depth = int(v);
-        else throw UsageError("--level: unknown key '" + k + "' (pixel, env, table, kappa, floor, bound)");
+        if (k == "pixel")
+            a.pixel_tolerance = v;
+        else if (k == "env")
+            a.env_tolerance = v;
+        else if (k == "table")
+            a.table_tolerance = v;
+        else if (k == "kappa")
+            a.kappa = v;
+        else if (k == "floor")
+            a.floor = v;
+        else if (k == "bound")
+            a.bound_depth = int(v);
+        else
+            throw UsageError("--level: unknown key '" + k + "' (pixel, env, table, kappa, floor, bound)");
     }
     return a;
 }
@@ -83,25 +90,24 @@ int run_nodes(const std::string& env_spec, const std::vector<TruthAccuracy>& lev
                 shade(env, L, shading_point(ns[k], v, L), rp, rgb);
                 ref[k] = rgb_size(rgb);
             }
-            for (const TruthAccuracy& a : levels)
-                {
-                    QuadratureParams p;
-                    p.tolerance = a.env_tolerance, p.kappa = a.kappa;
-                    p.floor = a.floor * env.mean_radiance();
-                    double worst = 0, ss = 0;
-                    ShadeStats st;
-                    const double c0 = cpu_seconds();
-                    for (size_t k = 0; k < ns.size(); ++k) {
-                        double rgb[3] = {0, 0, 0};
-                        shade(env, L, shading_point(ns[k], v, L), p, rgb, &st);
-                        const double e = std::fabs(rgb_size(rgb) - ref[k]) / (ref[k] + p.floor);
-                        worst = std::max(worst, e), ss += e * e;
-                    }
-                    const double us = 1e6 * (cpu_seconds() - c0) / double(ns.size());
-                    std::printf("r=%.2f %s %-8s env %.2g kappa %.2g: rms %.2e worst %.2e, %6.0f evals/pt, %7.1f us/pt\n", r,
-                                metal > 0 ? "metal" : "diel ", "adaptive", a.env_tolerance, a.kappa,
-                                std::sqrt(ss / double(ns.size())), worst, double(st.evaluations) / double(ns.size()), us);
+            for (const TruthAccuracy& a : levels) {
+                QuadratureParams p;
+                p.tolerance = a.env_tolerance, p.kappa = a.kappa;
+                p.floor = a.floor * env.mean_radiance();
+                double worst = 0, ss = 0;
+                ShadeStats st;
+                const double c0 = cpu_seconds();
+                for (size_t k = 0; k < ns.size(); ++k) {
+                    double rgb[3] = {0, 0, 0};
+                    shade(env, L, shading_point(ns[k], v, L), p, rgb, &st);
+                    const double e = std::fabs(rgb_size(rgb) - ref[k]) / (ref[k] + p.floor);
+                    worst = std::max(worst, e), ss += e * e;
                 }
+                const double us = 1e6 * (cpu_seconds() - c0) / double(ns.size());
+                std::printf("r=%.2f %s %-8s env %.2g kappa %.2g: rms %.2e worst %.2e, %6.0f evals/pt, %7.1f us/pt\n", r,
+                            metal > 0 ? "metal" : "diel ", "adaptive", a.env_tolerance, a.kappa,
+                            std::sqrt(ss / double(ns.size())), worst, double(st.evaluations) / double(ns.size()), us);
+            }
         }
     }
     return 0;
@@ -122,19 +128,32 @@ int main(int argc, char** argv) {
                 if (i + 1 >= argc) throw UsageError(a + " needs a value");
                 return argv[++i];
             };
-            if (a == "--scene") scene_name = next();
-            else if (a == "--env") env_spec = next();
-            else if (a == "--set") opts.set_from_string(next());
-            else if (a == "--threads") threads = std::stoi(next());
-            else if (a == "--level") levels.push_back(parse_level(next()));
-            else if (a == "--finer") finer = std::stoi(next());
-            else if (a == "--per-sphere") per_sphere = true;
-            else if (a == "--nodes") nodes = true;
-            else if (a == "--min-nv") min_nv = std::stod(next());
-            else if (a == "--only") only.push_back(next());
-            else if (a == "--save") save = next();
-            else if (a == "--against") against = next(), finer = 0;
-            else throw UsageError("unknown argument '" + a + "' (see the comment at the top of truth_convergence.cpp)");
+            if (a == "--scene")
+                scene_name = next();
+            else if (a == "--env")
+                env_spec = next();
+            else if (a == "--set")
+                opts.set_from_string(next());
+            else if (a == "--threads")
+                threads = std::stoi(next());
+            else if (a == "--level")
+                levels.push_back(parse_level(next()));
+            else if (a == "--finer")
+                finer = std::stoi(next());
+            else if (a == "--per-sphere")
+                per_sphere = true;
+            else if (a == "--nodes")
+                nodes = true;
+            else if (a == "--min-nv")
+                min_nv = std::stod(next());
+            else if (a == "--only")
+                only.push_back(next());
+            else if (a == "--save")
+                save = next();
+            else if (a == "--against")
+                against = next(), finer = 0;
+            else
+                throw UsageError("unknown argument '" + a + "' (see the comment at the top of truth_convergence.cpp)");
         }
         if (levels.empty()) levels.push_back(TruthAccuracy{});
         if (nodes) return run_nodes(env_spec, levels, min_nv);
@@ -174,16 +193,16 @@ int main(int argc, char** argv) {
             levels.push_back(levels.back());
         }
         const TruthImage& best = img.back();
-        std::printf("%s / %s, against the finest level (%s)\n", scene_name.c_str(), env_spec.c_str(), levels.back().json().dump().c_str());
+        std::printf("%s / %s, against the finest level (%s)\n", scene_name.c_str(), env_spec.c_str(),
+                    levels.back().json().dump().c_str());
         std::printf("%-3s %-44s %9s %9s %9s %9s %8s %8s\n", "lvl", "accuracy (pixel env table kappa)", "cpu s", "wall s",
                     "rel RMSE", "FLIP", "worst", "evals/1e6");
         for (size_t k = 0; k + 1 < img.size(); ++k) {
             const TruthBound b = compare_levels(img[k], best, scene);
             const double flip = compute_flip_hdr(best.image, img[k].image, FlipOptions{}).mean;
             const TruthAccuracy& a = levels[k];
-            std::printf("%-3zu %-44s %9.1f %9.1f %8.4f%% %9.5f %8.4f %8.1f\n", k,
-                        fmt_levels(a).c_str(), cpu[k], img[k].seconds, 100 * b.relative_rmse, flip, b.worst,
-                        1e-6 * double(img[k].evaluations));
+            std::printf("%-3zu %-44s %9.1f %9.1f %8.4f%% %9.5f %8.4f %8.1f\n", k, fmt_levels(a).c_str(), cpu[k], img[k].seconds,
+                        100 * b.relative_rmse, flip, b.worst, 1e-6 * double(img[k].evaluations));
             if (per_sphere)
                 for (const SphereBound& s : b.spheres)
                     std::printf("      %-16s rel %.4f%% worst %.4f (%d,%d)\n", s.label.c_str(), 100 * s.relative_rmse, s.worst,

@@ -100,9 +100,11 @@ GoldenWritten write_truth_golden(const GoldenRequest& req) {
     bound["mean_flip"] = flip.mean;
     bound["definition"] =
         "the golden is the finer of two refinement levels (every tolerance / 2, lobe guard / sqrt(2), the footprint's "
-        "variation bound one level deeper: provenance.levels); the bound is the difference between the two: relative_rmse = sqrt(mean((a-b)^2 / (m^2 + 0.01))), "
+        "variation bound one level deeper: provenance.levels); the bound is the difference between the two: relative_rmse = "
+        "sqrt(mean((a-b)^2 / (m^2 + 0.01))), "
         "m = (a+b)/2, over covered pixels and channels; worst_pixel = the largest per-pixel term sqrt((a-b)^2/(m^2+0.01)); "
-        "worst_pixel_relative = the largest |a-b|/m over pixels with m > 0.01; mean_flip = HDR-FLIP(finer, coarser). Not in it: an error that does not shrink between the "
+        "worst_pixel_relative = the largest |a-b|/m over pixels with m > 0.01; mean_flip = HDR-FLIP(finer, coarser). Not in it: "
+        "an error that does not shrink between the "
         "levels, measured at up to 6e-4 of a silhouette pixel's value (renderers/reference/CONVERGENCE.md)";
     bound["criterion"] = {{"mean_flip_below", kCriterionFlip},
                           {"relative_rmse_below", kCriterionRelativeRmse},
@@ -117,9 +119,10 @@ GoldenWritten write_truth_golden(const GoldenRequest& req) {
                 {"options", req.spec.options.canonical()},
                 {"width", r.fine.image.cols},
                 {"height", r.fine.image.rows},
-                {"env", {{"spec", portable_env_spec(req.spec.env)},
-                         {"content_hash", env.content_hash},
-                         {"negatives_clamped", env.negatives_clamped}}},
+                {"env",
+                 {{"spec", portable_env_spec(req.spec.env)},
+                  {"content_hash", env.content_hash},
+                  {"negatives_clamped", env.negatives_clamped}}},
                 {"integrator", "quadrature"},
                 {"deterministic", true},
                 {"error_bound", bound},

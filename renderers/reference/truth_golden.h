@@ -16,15 +16,15 @@ inline constexpr double kCriterionFlip = 0.002;
 inline constexpr double kCriterionRelativeRmse = 0.005;
 
 struct GoldenRequest {
-    TestSpec spec;          // method reference; the environment is loaded from spec.env
-    std::string out_exr;    // the golden; the sidecar is the same path with .json
-    std::string command;    // recorded as the regenerating command
-    Progress progress;      // optional
+    TestSpec spec;       // method reference; the environment is loaded from spec.env
+    std::string out_exr; // the golden; the sidecar is the same path with .json
+    std::string command; // recorded as the regenerating command
+    Progress progress;   // optional
 };
 
 struct GoldenWritten {
-    nlohmann::json meta;    // the sidecar's content
-    double mean_flip = 0;   // between the two levels
+    nlohmann::json meta;  // the sidecar's content
+    double mean_flip = 0; // between the two levels
     bool criterion_met = false;
 };
 
@@ -35,7 +35,7 @@ GoldenWritten write_truth_golden(const GoldenRequest& request);
 // frames (relative RMSE, worst pixel, HDR-FLIP, and LDR-FLIP after the display transform — the temporal
 // suite's own metric — each frame against its finer render). reference_sequence_key names it.
 struct SequenceRequest {
-    TestSpec spec;       // scene, env (loaded from spec.env), options (frame is set per frame)
+    TestSpec spec; // scene, env (loaded from spec.env), options (frame is set per frame)
     int frames = 32;
     std::vector<int> bound_frames = {0, 16};
     std::string out_exr;

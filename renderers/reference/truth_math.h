@@ -67,7 +67,8 @@ inline ShadingPoint shading_point(V3 n, V3 v, const MaterialLobe& L) {
     if (nv < kMinNdotV) {
         V3 t = v - nv * n;
         double tl = std::sqrt(dot(t, t));
-        V3 tn = tl > 1e-300 ? (1.0 / tl) * t : (std::fabs(n.x) < 0.9 ? normalize(V3{1, 0, 0} - n.x * n) : normalize(V3{0, 1, 0} - n.y * n));
+        V3 tn = tl > 1e-300 ? (1.0 / tl) * t
+                            : (std::fabs(n.x) < 0.9 ? normalize(V3{1, 0, 0} - n.x * n) : normalize(V3{0, 1, 0} - n.y * n));
         v = std::sqrt(1 - kMinNdotV * kMinNdotV) * tn + kMinNdotV * n;
         nv = kMinNdotV;
     }

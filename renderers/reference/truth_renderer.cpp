@@ -3,10 +3,10 @@
 #include "renderers/reference/truth_renderer.h"
 
 #include <atomic>
-#include <cstdlib>
-#include <memory>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
+#include <memory>
 #include <mutex>
 #include <thread>
 
@@ -37,8 +37,12 @@ TruthAccuracy TruthAccuracy::temporal() {
 }
 
 nlohmann::json TruthAccuracy::json() const {
-    return {{"pixel_tolerance", pixel_tolerance}, {"env_tolerance", env_tolerance}, {"table_tolerance", table_tolerance},
-            {"floor_of_mean_radiance", floor}, {"kappa", kappa}, {"bound_depth", bound_depth}};
+    return {{"pixel_tolerance", pixel_tolerance},
+            {"env_tolerance", env_tolerance},
+            {"table_tolerance", table_tolerance},
+            {"floor_of_mean_radiance", floor},
+            {"kappa", kappa},
+            {"bound_depth", bound_depth}};
 }
 
 namespace {
@@ -58,10 +62,10 @@ std::shared_ptr<const NormalTable> normal_table(const EnvPyramid& env, const std
     static std::mutex m;
     static std::vector<std::pair<std::string, std::shared_ptr<const NormalTable>>> cache;
     const V3 v = sv.view(), r = sv.right(), u = sv.up();
-    const std::string key = fmt::format("{}|{}|{}|{},{},{}|{},{},{}|{},{},{}|{},{},{}|{}|{}", env_key, L.alpha,
-                                        int(L.diffuse) + 2 * int(L.specular), L.f0[0], L.f0[1], L.f0[2], L.kd[0], L.kd[1],
-                                        L.kd[2], v.x, v.y, v.z, r.x, r.y, r.z, acc.json().dump(),
-                                        int(sv.sphere().bump_amplitude > 0));
+    const std::string key =
+        fmt::format("{}|{}|{}|{},{},{}|{},{},{}|{},{},{}|{},{},{}|{}|{}", env_key, L.alpha, int(L.diffuse) + 2 * int(L.specular),
+                    L.f0[0], L.f0[1], L.f0[2], L.kd[0], L.kd[1], L.kd[2], v.x, v.y, v.z, r.x, r.y, r.z, acc.json().dump(),
+                    int(sv.sphere().bump_amplitude > 0));
     {
         std::lock_guard<std::mutex> lock(m);
         for (auto& [k, t] : cache)
@@ -71,8 +75,10 @@ std::shared_ptr<const NormalTable> normal_table(const EnvPyramid& env, const std
     tp.tolerance = acc.table_tolerance, tp.floor = acc.floor * env.mean_radiance(), tp.kappa = acc.kappa;
     // A pixel's footprint in normal space: 1/R rad at the disc's centre; bumps sweep ~0.5 rad per pixel.
     tp.footprint = 1 / sv.disc().r;
-    if (sv.sphere().bump_amplitude > 0) tp.min_nv = -0.5, tp.weight_offset = 0.3, tp.footprint = 0.3;
-    else tp.min_nv = -0.02; // lookups on the silhouette stay inside
+    if (sv.sphere().bump_amplitude > 0)
+        tp.min_nv = -0.5, tp.weight_offset = 0.3, tp.footprint = 0.3;
+    else
+        tp.min_nv = -0.02; // lookups on the silhouette stay inside
     auto t = std::make_shared<const NormalTable>(env, L, v, r, u, tp, quadrature_params(acc, env), threads, progress);
     std::lock_guard<std::mutex> lock(m);
     cache.emplace_back(key, t);
@@ -85,8 +91,8 @@ std::shared_ptr<const NormalTable> normal_table(const EnvPyramid& env, const std
 // radiance's range over a square's reflection cone — drives the refinement); everything else through
 // the sphere's normal table (lookups), with the table's range over a square's cone of normals as the
 // variation bound.
-void shade_pixel(const SphereView& sv, const EnvPyramid& env, const NormalTable* table, const TruthAccuracy& acc, int px,
-                 int py, double rgb[3], double& coverage, long& points) {
+void shade_pixel(const SphereView& sv, const EnvPyramid& env, const NormalTable* table, const TruthAccuracy& acc, int px, int py,
+                 double rgb[3], double& coverage, long& points) {
     FootprintParams fp;
     fp.tolerance = acc.pixel_tolerance;
     fp.bound_depth = acc.bound_depth;
@@ -257,12 +263,13 @@ TruthRender render_truth(const TestSpec& spec, const Environment& env_in, const 
         {"height", H},
         {"threads", threads},
         {"lobes", lobes_s},
-        {"env", {{"spec", env.spec.empty() ? spec.env : env.spec},
-                 {"content_hash", env.content_hash},
-                 {"width", env.equirect.cols},
-                 {"height", env.equirect.rows},
-                 {"negatives_clamped", env.negatives_clamped},
-                 {"rotation_deg", env.rotation_deg}}},
+        {"env",
+         {{"spec", env.spec.empty() ? spec.env : env.spec},
+          {"content_hash", env.content_hash},
+          {"width", env.equirect.cols},
+          {"height", env.equirect.rows},
+          {"negatives_clamped", env.negatives_clamped},
+          {"rotation_deg", env.rotation_deg}}},
         {"levels", {{"coarse", acc.json()}, {"fine", acc.finer().json()}}},
         {"evaluations", {{"coarse", r.coarse.evaluations}, {"fine", r.fine.evaluations}}},
         {"level_seconds", {{"coarse", r.coarse.seconds}, {"fine", r.fine.seconds}}},

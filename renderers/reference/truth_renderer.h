@@ -19,14 +19,14 @@ namespace iblcheck::truth {
 // One refinement level. finer() tightens every control (the bound is the difference between a level
 // and its finer one, so the finer one must be finer in every error source): tolerances / 2, guard / √2.
 struct TruthAccuracy {
-    double pixel_tolerance = 1e-3;   // footprint.h, relative per pixel (table and mirror lookups are cheap)
-    double env_tolerance = 2.5e-4;   // lobe_quadrature.h, relative per shading point (table node)
-    double table_tolerance = 2e-2;   // normal_table.h, the bilinear error that splits a cell (the leaves
-                                     // interpolate biquadratically: their error is an order smaller)
-    double floor = 1e-3;             // of every tolerance, × the environment's mean radiance
-    double kappa = 2;                // lobe guards (quadrature and table), × the lobe's width (2 instead of 1:
-                                     // 21 % less time, the same error: CONVERGENCE.md)
-    int bound_depth = 6;             // footprint.h: the variation bound splits squares down to 2^-depth px
+    double pixel_tolerance = 1e-3; // footprint.h, relative per pixel (table and mirror lookups are cheap)
+    double env_tolerance = 2.5e-4; // lobe_quadrature.h, relative per shading point (table node)
+    double table_tolerance = 2e-2; // normal_table.h, the bilinear error that splits a cell (the leaves
+                                   // interpolate biquadratically: their error is an order smaller)
+    double floor = 1e-3;           // of every tolerance, × the environment's mean radiance
+    double kappa = 2;              // lobe guards (quadrature and table), × the lobe's width (2 instead of 1:
+                                   // 21 % less time, the same error: CONVERGENCE.md)
+    int bound_depth = 6;           // footprint.h: the variation bound splits squares down to 2^-depth px
     // The temporal sequences' accuracy: a bumped sphere's pixels average a wide cone of normals, so every
     // control is looser (measured in CONVERGENCE.md, "The temporal truth").
     static TruthAccuracy temporal();
@@ -38,9 +38,9 @@ struct TruthAccuracy {
 using Progress = std::function<void(double)>;
 
 struct TruthImage {
-    cv::Mat image;     // CV_32FC3
-    cv::Mat coverage;  // CV_32FC1, exact |pixel ∩ silhouettes|
-    cv::Mat sphere;    // CV_32SC1, the sphere covering most of the pixel (−1: background)
+    cv::Mat image;             // CV_32FC3
+    cv::Mat coverage;          // CV_32FC1, exact |pixel ∩ silhouettes|
+    cv::Mat sphere;            // CV_32SC1, the sphere covering most of the pixel (−1: background)
     long evaluations = 0;      // BRDF evaluations (all in the normal tables' nodes)
     long table_nodes = 0;      // shading points
     long footprint_points = 0; // table lookups and mirror lookups

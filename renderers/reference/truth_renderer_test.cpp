@@ -34,7 +34,7 @@ cv::Vec3f px(const cv::Mat& m, int x, int y) { return m.at<cv::Vec3f>(y, x); }
 TEST(TruthRenderer, FurnaceIdentities) {
     TruthRender m = render_truth(spec_of("furnace", "constant:1"), load_environment("constant:1"));
     // 320x64, spheres of 64 px cells centred at x = 32 + 64 i, y = 32 (pixel 31.5..32.5 is the centre).
-    EXPECT_NEAR(px(m.result.image, 160, 31)[1] / 2 + px(m.result.image, 159, 32)[1] / 2, 0.91581, 2e-4); // r = 0.5
+    EXPECT_NEAR(px(m.result.image, 160, 31)[1] / 2 + px(m.result.image, 159, 32)[1] / 2, 0.91581, 2e-4);           // r = 0.5
     EXPECT_NEAR(px(m.result.image, 288, 31)[1] / 2 + px(m.result.image, 287, 32)[1] / 2, 1 - std::log(2.0), 2e-4); // r = 1
     EXPECT_NEAR(px(m.result.image, 32, 32)[0], 1.0, 1e-4); // mirror, F0 = 1
     TestSpec d = spec_of("furnace_dielectric", "constant:1");
@@ -112,8 +112,8 @@ TEST(TruthRenderer, RefinementBoundBoundsTheErrorAgainstAFinerSolution) {
     // stated 0.049 %), so a sphere may be under-stated by 2x at most; the image's bound above holds as is.
     for (size_t s = 0; s < scene.spheres.size(); ++s)
         EXPECT_LE(actual.spheres[s].relative_rmse, 2.0 * bound.spheres[s].relative_rmse + 1e-5) << scene.labels[s];
-    std::printf("bound (coarse vs fine): rel. RMSE %.5f worst %.5f; actual (fine vs 4x finer): %.5f, %.5f\n",
-                bound.relative_rmse, bound.worst, actual.relative_rmse, actual.worst);
+    std::printf("bound (coarse vs fine): rel. RMSE %.5f worst %.5f; actual (fine vs 4x finer): %.5f, %.5f\n", bound.relative_rmse,
+                bound.worst, actual.relative_rmse, actual.worst);
 }
 
 // The Monte Carlo integrator agrees within its own noise: per sphere, the image means differ by less

@@ -9,8 +9,8 @@
 
 namespace iblcheck::truth {
 
-TruthSequence render_truth_sequence(const TestSpec& spec, const Environment& env_in, int frames, const std::vector<int>& bound_frames,
-                                    const Progress& progress) {
+TruthSequence render_truth_sequence(const TestSpec& spec, const Environment& env_in, int frames,
+                                    const std::vector<int>& bound_frames, const Progress& progress) {
     const auto t0 = std::chrono::steady_clock::now();
     if (frames < 1) throw UsageError("temporal truth: frames must be >= 1, got " + std::to_string(frames));
     for (int f : bound_frames)

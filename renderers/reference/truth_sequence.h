@@ -25,7 +25,7 @@ struct TruthSequence {
 
 // spec: scene, size, options (the frame option is set per frame; threads, env_rotation as render_truth).
 // Throws UsageError for frames < 1 or a bound frame outside [0, frames).
-TruthSequence render_truth_sequence(const TestSpec& spec, const Environment& env, int frames, const std::vector<int>& bound_frames,
-                                    const Progress& progress = {});
+TruthSequence render_truth_sequence(const TestSpec& spec, const Environment& env, int frames,
+                                    const std::vector<int>& bound_frames, const Progress& progress = {});
 
 } // namespace iblcheck::truth

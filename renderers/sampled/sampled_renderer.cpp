@@ -33,16 +33,24 @@ RenderResult render_sampled(GpuSession& gpu, const Environment& env, const TestS
     vk::Context& ctx = gpu.ctx();
     vk::Buffer scene_buf = upload_scene(ctx, scene);
     vk::Buffer out = ctx.create_buffer(VkDeviceSize(width) * height * 16);
-    SampledPush pc{uint32_t(width), uint32_t(height), uint32_t(o.get_int("ssaa", 2)), uint32_t(samples), ps.cube_size,
-         uint32_t(o.get_int("seed", 0)), float(ibl.full_mips - 1), float(o.get_double("min_lod", 0.0)),
-         float(o.get_double("diffuse_roughness", 0.9))};
+    SampledPush pc{uint32_t(width),
+                   uint32_t(height),
+                   uint32_t(o.get_int("ssaa", 2)),
+                   uint32_t(samples),
+                   ps.cube_size,
+                   uint32_t(o.get_int("seed", 0)),
+                   float(ibl.full_mips - 1),
+                   float(o.get_double("min_lod", 0.0)),
+                   float(o.get_double("diffuse_roughness", 0.9))};
     if (pc.ssaa < 1 || pc.ssaa > 16) throw UsageError("option 'ssaa' must be in 1..16");
 
     // Bindings 3 and 4 are unused by this shader; the layout keeps the mobile numbering.
     std::vector<vk::Binding> b = {vk::Binding::storage_buffer(0, scene_buf),
                                   vk::Binding::sampled_image(1, ibl.source_cube.sampled_view, ctx.linear_sampler()),
-                                  vk::Binding::storage_buffer(2, ibl.sh), vk::Binding::storage_buffer(3, ibl.sh),
-                                  vk::Binding::storage_buffer(4, ibl.sh), vk::Binding::storage_buffer(5, out)};
+                                  vk::Binding::storage_buffer(2, ibl.sh),
+                                  vk::Binding::storage_buffer(3, ibl.sh),
+                                  vk::Binding::storage_buffer(4, ibl.sh),
+                                  vk::Binding::storage_buffer(5, out)};
     vk::GpuTimer timer(ctx, 1);
     ctx.submit([&](VkCommandBuffer cmd) {
         timer.reset(cmd);
@@ -55,10 +63,12 @@ RenderResult render_sampled(GpuSession& gpu, const Environment& env, const TestS
     for (auto& [name, ms] : timer.results()) result.timings.push_back({name, ms, true, false});
     double coverage = read_back_image(out, width, height, result.image);
     result.texture_fetches_per_pixel = coverage * pc.ssaa * pc.ssaa * samples;
-    auto instructions = shading_instructions_per_pixel(gpu, {"shade_sampled.comp", {}, types, {}, b, 5, &pc, sizeof pc, width, height}, out);
+    auto instructions =
+        shading_instructions_per_pixel(gpu, {"shade_sampled.comp", {}, types, {}, b, 5, &pc, sizeof pc, width, height}, out);
     result.shader_instructions_per_pixel = instructions.value_or(0);
-    result.provenance = {{"method", "sampled"}, {"precompute_cached", cached}, {"samples", samples}, {"cube_size", ps.cube_size},
-                         {"seed", pc.seed}, {"cost", cost_provenance(instructions, result.texture_fetches_per_pixel)}};
+    result.provenance = {{"method", "sampled"}, {"precompute_cached", cached},
+                         {"samples", samples},  {"cube_size", ps.cube_size},
+                         {"seed", pc.seed},     {"cost", cost_provenance(instructions, result.texture_fetches_per_pixel)}};
     return result;
 }
 

@@ -31,8 +31,7 @@ Material material_from_options(const OptionMap& o) {
     if (m.metallic < 0 || m.metallic > 1)
         throw UsageError("option 'metallic': " + o.get_string("metallic", "") + " is outside [0, 1]");
     for (float c : {m.base_color.x, m.base_color.y, m.base_color.z})
-        if (c < 0 || c > 1)
-            throw UsageError("option 'base_color': " + o.get_string("base_color", "") + " is outside [0, 1]");
+        if (c < 0 || c > 1) throw UsageError("option 'base_color': " + o.get_string("base_color", "") + " is outside [0, 1]");
     return m;
 }
 
@@ -61,8 +60,8 @@ Scene build_roughness_sweep(const OptionMap& o) {
     s.name = "roughness_sweep";
     s.width = 11 * 48;
     s.height = 2 * 48;
-    s.camera.half_height = 1.0f; // 2 world units tall, 11 wide: one unit per sphere cell
-    Vec3f metal_color{0.95f, 0.64f, 0.54f};  // copper
+    s.camera.half_height = 1.0f;              // 2 world units tall, 11 wide: one unit per sphere cell
+    Vec3f metal_color{0.95f, 0.64f, 0.54f};   // copper
     Vec3f dielectric_color{0.5f, 0.5f, 0.5f}; // mid grey
     for (int row = 0; row < 2; ++row) {
         for (int i = 0; i <= 10; ++i) {
@@ -119,7 +118,7 @@ Scene build_grazing(const OptionMap& o) {
 
 // Animated normal detail for the temporal suite: the bumps (renderers/shaders/scene.glsl,
 // bump_normal) move by kBumpPhasePerFrame radians each frame, a fixed time step.
-constexpr float kBumpAmplitude = 0.0008f;  // tilts the normal by up to ~0.16 rad
+constexpr float kBumpAmplitude = 0.0008f; // tilts the normal by up to ~0.16 rad
 constexpr float kBumpFrequency = 200.0f;  // ≈ 1.8 px wavelength at 128 px: sub-pixel detail that sparkles
 constexpr float kBumpPhasePerFrame = 0.9f;
 
@@ -148,7 +147,7 @@ Scene build_bumpy_sphere(const OptionMap& o) {
 // frame along a 20° diagonal (so both axes move by fractions of a pixel); the grid reaches 80 px
 // left of and above the view so drifting spheres keep it filled for 32+ frames.
 constexpr int kFieldGrid = 8;
-constexpr float kFieldPixel = 1.0f / 64.0f;    // world units per pixel at 128x128, half-height 1
+constexpr float kFieldPixel = 1.0f / 64.0f; // world units per pixel at 128x128, half-height 1
 constexpr float kFieldRadiusPx = 3.5f;
 constexpr float kFieldSpacingPx = 20.0f;
 constexpr float kFieldDriftDeg = 20.0f;
@@ -177,7 +176,7 @@ Scene build_sphere_field(const OptionMap& o) {
     for (int j = 0; j < kFieldGrid; ++j)
         for (int i = 0; i < kFieldGrid; ++i) {
             uint32_t k = uint32_t(j * kFieldGrid + i);
-            float speed = 0.30f + 0.15f * field_hash(k, 1);  // px per frame
+            float speed = 0.30f + 0.15f * field_hash(k, 1); // px per frame
             // Pixel position (x right, y down, relative to the view centre) at this frame.
             float px = -80.0f + kFieldSpacingPx * float(i) + field_hash(k, 2) + speed * frame * dx;
             float py = -80.0f + kFieldSpacingPx * float(j) + field_hash(k, 3) + speed * frame * dy;
@@ -237,8 +236,8 @@ std::vector<SceneInfo> scene_catalog() {
 }
 
 const std::vector<std::string>& scene_option_keys() {
-    static const std::vector<std::string> keys = {"roughness", "metallic", "base_color", "frame", "bump_amplitude", "bump_frequency",
-                                                 "roughness_bias", "camera_shift", "ao"};
+    static const std::vector<std::string> keys = {"roughness",      "metallic",       "base_color",   "frame", "bump_amplitude",
+                                                  "bump_frequency", "roughness_bias", "camera_shift", "ao"};
     return keys;
 }
 
@@ -265,7 +264,8 @@ void apply_perturbations(Scene& s, const OptionMap& o) {
     Vec3f f{c.target.x - c.eye.x, c.target.y - c.eye.y, c.target.z - c.eye.z};
     float fl = std::sqrt(f.x * f.x + f.y * f.y + f.z * f.z);
     f = {f.x / fl, f.y / fl, f.z / fl};
-    Vec3f r{f.y * c.world_up.z - f.z * c.world_up.y, f.z * c.world_up.x - f.x * c.world_up.z, f.x * c.world_up.y - f.y * c.world_up.x};
+    Vec3f r{f.y * c.world_up.z - f.z * c.world_up.y, f.z * c.world_up.x - f.x * c.world_up.z,
+            f.x * c.world_up.y - f.y * c.world_up.x};
     float rl = std::sqrt(r.x * r.x + r.y * r.y + r.z * r.z);
     r = {r.x / rl, r.y / rl, r.z / rl};
     Vec3f u{r.y * f.z - r.z * f.y, r.z * f.x - r.x * f.z, r.x * f.y - r.y * f.x};

@@ -43,15 +43,15 @@ struct Camera {
     Vec3f eye{0, 0, 5};
     Vec3f target{0, 0, 0};
     Vec3f world_up{0, 1, 0};
-    float half_height = 1.1f;   // orthographic
-    float fov_y_deg = 40.0f;    // perspective
+    float half_height = 1.1f; // orthographic
+    float fov_y_deg = 40.0f;  // perspective
 };
 
 struct Scene {
     std::string name;
     Camera camera;
     std::vector<Sphere> spheres;
-    int width = 128;  // default image size; --size overrides
+    int width = 128; // default image size; --size overrides
     int height = 128;
     // Labels of the spheres in order (e.g. "metal r=0.3"), used by per-roughness metrics.
     std::vector<std::string> labels;

@@ -7,14 +7,12 @@
 
 namespace iblcheck::vk {
 
-ComputePipeline::ComputePipeline(Context& ctx, const CompiledShader& shader,
-                                 const std::vector<VkDescriptorType>& bindings, uint32_t push_constant_bytes,
-                                 const std::vector<SpecConstant>& spec)
+ComputePipeline::ComputePipeline(Context& ctx, const CompiledShader& shader, const std::vector<VkDescriptorType>& bindings,
+                                 uint32_t push_constant_bytes, const std::vector<SpecConstant>& spec)
     : ctx_(ctx), push_bytes_(push_constant_bytes) {
     VkDevice dev = ctx.device();
     std::vector<VkDescriptorSetLayoutBinding> lb;
-    for (uint32_t i = 0; i < bindings.size(); ++i)
-        lb.push_back({i, bindings[i], 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr});
+    for (uint32_t i = 0; i < bindings.size(); ++i) lb.push_back({i, bindings[i], 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr});
     if (shader.counts_instructions && bindings.size() > kCostBinding)
         throw Error("ComputePipeline: binding " + std::to_string(kCostBinding) + " is the instruction counter's");
     if (shader.counts_instructions)
@@ -65,7 +63,7 @@ ComputePipeline::~ComputePipeline() {
 
 void Context::push_descriptors(VkCommandBuffer cmd, VkPipelineBindPoint bind_point, VkPipelineLayout layout,
                                const std::vector<Binding>& bindings) const {
-    if (bindings.empty()) return;  // zero writes is invalid usage
+    if (bindings.empty()) return; // zero writes is invalid usage
     std::vector<VkWriteDescriptorSet> writes(bindings.size());
     std::vector<VkDescriptorBufferInfo> bufs(bindings.size());
     std::vector<VkDescriptorImageInfo> imgs(bindings.size());
@@ -87,8 +85,8 @@ void Context::push_descriptors(VkCommandBuffer cmd, VkPipelineBindPoint bind_poi
     push_descriptor_fn_(cmd, bind_point, layout, 0, uint32_t(writes.size()), writes.data());
 }
 
-void ComputePipeline::dispatch(VkCommandBuffer cmd, const std::vector<Binding>& bindings, const void* push,
-                               uint32_t push_bytes, uint32_t gx, uint32_t gy, uint32_t gz) const {
+void ComputePipeline::dispatch(VkCommandBuffer cmd, const std::vector<Binding>& bindings, const void* push, uint32_t push_bytes,
+                               uint32_t gx, uint32_t gy, uint32_t gz) const {
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);
     ctx_.push_descriptors(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, bindings);
     if (push && push_bytes) vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, push_bytes, push);

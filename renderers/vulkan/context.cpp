@@ -29,8 +29,7 @@ std::string result_name(VkResult r) {
     }
 }
 
-VKAPI_ATTR VkBool32 VKAPI_CALL debug_callback(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
-                                              VkDebugUtilsMessageTypeFlagsEXT,
+VKAPI_ATTR VkBool32 VKAPI_CALL debug_callback(VkDebugUtilsMessageSeverityFlagBitsEXT severity, VkDebugUtilsMessageTypeFlagsEXT,
                                               const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
     static_cast<Context*>(user)->on_validation_message(int(severity), data->pMessage);
     return VK_FALSE;
@@ -109,9 +108,7 @@ std::vector<DeviceEntry> enumerate(VkInstance inst) {
     return out;
 }
 
-std::string describe(const DeviceEntry& e) {
-    return std::string(e.props.deviceName) + " [driver " + e.driver.driverName + "]";
-}
+std::string describe(const DeviceEntry& e) { return std::string(e.props.deviceName) + " [driver " + e.driver.driverName + "]"; }
 
 VkDebugUtilsMessengerEXT create_messenger(VkInstance instance, Context* ctx) {
     auto mi = vk_struct<VkDebugUtilsMessengerCreateInfoEXT>(VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT);
@@ -120,8 +117,8 @@ VkDebugUtilsMessengerEXT create_messenger(VkInstance instance, Context* ctx) {
                      VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
     mi.pfnUserCallback = debug_callback;
     mi.pUserData = ctx;
-    auto fn = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
-        vkGetInstanceProcAddr(instance, "vkCreateDebugUtilsMessengerEXT"));
+    auto fn =
+        reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(vkGetInstanceProcAddr(instance, "vkCreateDebugUtilsMessengerEXT"));
     VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
     if (fn) check(fn(instance, &mi, nullptr, &messenger), "vkCreateDebugUtilsMessengerEXT");
     return messenger;
@@ -208,7 +205,7 @@ VkDevice create_device(VkPhysicalDevice pd, uint32_t queue_family, DeviceInfo& i
     e2.pNext = &e11;
     e2.features.shaderInt16 = f2.features.shaderInt16;
     e2.features.shaderFloat64 = f2.features.shaderFloat64;
-    e2.features.shaderInt64 = f2.features.shaderInt64;                  // instruction counting
+    e2.features.shaderInt64 = f2.features.shaderInt64; // instruction counting
     e12.shaderBufferInt64Atomics = f12.shaderBufferInt64Atomics;
     e2.features.vertexPipelineStoresAndAtomics = f2.features.vertexPipelineStoresAndAtomics; // counting a draw
     e2.features.fragmentStoresAndAtomics = f2.features.fragmentStoresAndAtomics;
@@ -276,11 +273,11 @@ Context::Context(const ContextOptions& options) {
         queue_family_ = choose_queue_family(chosen, info_);
         device_ = create_device(physical_, queue_family_, info_);
         vkGetDeviceQueue(device_, queue_family_, 0, &queue_);
-        push_descriptor_fn_ = reinterpret_cast<PFN_vkCmdPushDescriptorSetKHR>(
-            vkGetDeviceProcAddr(device_, "vkCmdPushDescriptorSetKHR"));
+        push_descriptor_fn_ =
+            reinterpret_cast<PFN_vkCmdPushDescriptorSetKHR>(vkGetDeviceProcAddr(device_, "vkCmdPushDescriptorSetKHR"));
         create_pool_and_samplers();
     } catch (...) {
-        destroy();  // the destructor does not run for a constructor that throws
+        destroy(); // the destructor does not run for a constructor that throws
         throw;
     }
 }

@@ -25,13 +25,13 @@ struct ContextOptions {
 };
 
 struct DeviceInfo {
-    std::string device_name;   // "llvmpipe (LLVM 15.0.6, 256 bits)"
-    std::string driver_name;   // "llvmpipe"
-    std::string driver_info;   // "Mesa 22.3.6 (LLVM 15.0.6)"
-    std::string mesa_version;  // "22.3.6" when the driver is Mesa's
-    std::string llvm_version;  // "15.0.6" when the driver reports one
-    std::string api_version;   // "1.3.230"
-    std::string device_type;   // "cpu", "discrete-gpu", ...
+    std::string device_name;  // "llvmpipe (LLVM 15.0.6, 256 bits)"
+    std::string driver_name;  // "llvmpipe"
+    std::string driver_info;  // "Mesa 22.3.6 (LLVM 15.0.6)"
+    std::string mesa_version; // "22.3.6" when the driver is Mesa's
+    std::string llvm_version; // "15.0.6" when the driver reports one
+    std::string api_version;  // "1.3.230"
+    std::string device_type;  // "cpu", "discrete-gpu", ...
     uint32_t vendor_id = 0, device_id = 0;
     bool shader_float16 = false;
     bool storage_16bit = false;
@@ -74,8 +74,8 @@ struct Image {
     VkFormat format = VK_FORMAT_UNDEFINED;
     uint32_t width = 0, height = 0, mips = 1, layers = 1;
     bool cube = false;
-    VkImageView sampled_view = VK_NULL_HANDLE;          // whole image (cube or 2D)
-    std::vector<VkImageView> storage_views;             // per mip: 2D-array view (cube) or 2D view
+    VkImageView sampled_view = VK_NULL_HANDLE; // whole image (cube or 2D)
+    std::vector<VkImageView> storage_views;    // per mip: 2D-array view (cube) or 2D view
     Image() = default;
     Image(const Image&) = delete;
     Image& operator=(const Image&) = delete;
@@ -92,12 +92,8 @@ struct Binding {
     VkImageView view = VK_NULL_HANDLE;
     VkSampler sampler = VK_NULL_HANDLE;
     VkImageLayout layout = VK_IMAGE_LAYOUT_GENERAL;
-    static Binding storage_buffer(uint32_t b, const Buffer& buf) {
-        return {b, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, buf.buffer};
-    }
-    static Binding storage_image(uint32_t b, VkImageView v) {
-        return {b, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_NULL_HANDLE, v};
-    }
+    static Binding storage_buffer(uint32_t b, const Buffer& buf) { return {b, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, buf.buffer}; }
+    static Binding storage_image(uint32_t b, VkImageView v) { return {b, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_NULL_HANDLE, v}; }
     static Binding sampled_image(uint32_t b, VkImageView v, VkSampler s) {
         return {b, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_NULL_HANDLE, v, s};
     }
@@ -123,8 +119,8 @@ class ComputePipeline {
     void warm_up(VkCommandBuffer cmd, const std::vector<Binding>& bindings, const void* push, uint32_t push_bytes) const;
 
     // Records bind + push descriptors + push constants + dispatch.
-    void dispatch(VkCommandBuffer cmd, const std::vector<Binding>& bindings, const void* push, uint32_t push_bytes,
-                  uint32_t gx, uint32_t gy = 1, uint32_t gz = 1) const;
+    void dispatch(VkCommandBuffer cmd, const std::vector<Binding>& bindings, const void* push, uint32_t push_bytes, uint32_t gx,
+                  uint32_t gy = 1, uint32_t gz = 1) const;
 
   private:
     Context& ctx_;
@@ -173,17 +169,20 @@ class Context {
     // Validation messages of severity error since creation (or the last reset).
     int validation_errors() const { return validation_errors_; }
     const std::vector<std::string>& validation_messages() const { return validation_messages_; }
-    void reset_validation_errors() { validation_errors_ = 0; validation_messages_.clear(); }
+    void reset_validation_errors() {
+        validation_errors_ = 0;
+        validation_messages_.clear();
+    }
 
     Buffer create_buffer(VkDeviceSize size, VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
-                                                                         VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
-                                                                         VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+                                                                       VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
+                                                                       VK_BUFFER_USAGE_TRANSFER_DST_BIT);
     // A 2D image or a cube (layers = 6), with `mips` levels, usable as storage + sampled + transfer.
     Image create_image(VkFormat format, uint32_t width, uint32_t height, uint32_t mips, bool cube);
     bool format_supports(VkFormat format, VkFormatFeatureFlags features) const;
 
-    VkSampler linear_sampler() const { return linear_sampler_; }        // trilinear, clamp
-    VkSampler equirect_sampler() const { return equirect_sampler_; }    // bilinear, wrap u, clamp v
+    VkSampler linear_sampler() const { return linear_sampler_; }     // trilinear, clamp
+    VkSampler equirect_sampler() const { return equirect_sampler_; } // bilinear, wrap u, clamp v
     VkSampler nearest_sampler() const { return nearest_sampler_; }
 
     // Records a one-shot command buffer, submits it and waits.

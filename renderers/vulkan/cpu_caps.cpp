@@ -38,8 +38,7 @@ bool mesa_bool(const char* v) {
     return true;
 }
 
-LlvmpipeCaps caps_from(const std::string& cpuinfo_flags, const char* override_caps, const char* native_vector_width,
-                       bool nosse) {
+LlvmpipeCaps caps_from(const std::string& cpuinfo_flags, const char* override_caps, const char* native_vector_width, bool nosse) {
     std::set<std::string> f = flag_set(cpuinfo_flags);
     auto has = [&](const char* name) { return f.count(name) != 0; };
     LlvmpipeCaps c;
@@ -60,13 +59,20 @@ LlvmpipeCaps caps_from(const std::string& cpuinfo_flags, const char* override_ca
     if (nosse) c.sse = false;
     c.override_caps = override_caps ? override_caps : "";
     const std::string& o = c.override_caps;
-    if (o == "nosse") c.sse = false;
-    else if (o == "sse") c.sse2 = false;
-    else if (o == "sse2") c.sse3 = false;
-    else if (o == "sse3") c.ssse3 = false;
-    else if (o == "ssse3") c.sse41 = false;
-    else if (o == "sse4.1") c.avx = false;
-    else if (o == "avx") c.avx512 = false;
+    if (o == "nosse")
+        c.sse = false;
+    else if (o == "sse")
+        c.sse2 = false;
+    else if (o == "sse2")
+        c.sse3 = false;
+    else if (o == "sse3")
+        c.ssse3 = false;
+    else if (o == "ssse3")
+        c.sse41 = false;
+    else if (o == "sse4.1")
+        c.avx = false;
+    else if (o == "avx")
+        c.avx512 = false;
     else if (!o.empty())
         c.warning = "GALLIUM_OVERRIDE_CPU_CAPS='" + o +
                     "' is not a value Mesa 22.3 recognises (nosse, sse, sse2, sse3, ssse3, sse4.1, avx): ignored";
@@ -102,16 +108,21 @@ std::string LlvmpipeCaps::cpu_class() const {
     // vector width. AVX-512 is left out on purpose: llvmpipe caps the width at 256 bits and, on this
     // machine (Mesa 22.3, LLVM 15), renders with AVX-512 on and off (GALLIUM_OVERRIDE_CPU_CAPS=avx)
     // are bit-identical, ci suite included, so it would only split golden sets for nothing.
-    std::string isa = avx2 ? "avx2" : avx ? "avx" : sse41 ? "sse4.1" : ssse3 ? "ssse3" : sse3 ? "sse3"
-                    : sse2 ? "sse2" : sse ? "sse" : "nosse";
+    std::string isa = avx2    ? "avx2"
+                      : avx   ? "avx"
+                      : sse41 ? "sse4.1"
+                      : ssse3 ? "ssse3"
+                      : sse3  ? "sse3"
+                      : sse2  ? "sse2"
+                      : sse   ? "sse"
+                              : "nosse";
     if (isa == "nosse") return vector_width == 128 ? isa : isa + "-" + std::to_string(vector_width);
     if (fma) isa += "-fma";
     if (f16c) isa += "-f16c";
     return isa + "-" + std::to_string(vector_width);
 }
 
-LlvmpipeCaps llvmpipe_caps_from(const std::string& cpuinfo_flags, const char* override_caps,
-                                const char* native_vector_width) {
+LlvmpipeCaps llvmpipe_caps_from(const std::string& cpuinfo_flags, const char* override_caps, const char* native_vector_width) {
     return caps_from(cpuinfo_flags, override_caps, native_vector_width, false);
 }
 

@@ -12,9 +12,10 @@ namespace iblcheck {
 
 struct LlvmpipeCaps {
     bool sse41 = false, avx = false, avx2 = false, f16c = false, fma = false, avx512 = false;
-    int vector_width = 128;          // bits llvmpipe vectorises with (256 with AVX, LP_NATIVE_VECTOR_WIDTH overrides)
-    std::string override_caps;       // GALLIUM_OVERRIDE_CPU_CAPS as read ("" if unset)
-    std::string cpu_class() const;   // short stable name of what changes llvmpipe's code: e.g. "avx2-fma-f16c-256", "sse4.1-128", "nosse"
+    int vector_width = 128;    // bits llvmpipe vectorises with (256 with AVX, LP_NATIVE_VECTOR_WIDTH overrides)
+    std::string override_caps; // GALLIUM_OVERRIDE_CPU_CAPS as read ("" if unset)
+    std::string
+    cpu_class() const; // short stable name of what changes llvmpipe's code: e.g. "avx2-fma-f16c-256", "sse4.1-128", "nosse"
 
     // Beyond the agreed fields: the SSE levels below 4.1, which the overrides nosse..ssse3 take
     // away (cpu_class needs them to tell "sse2-128" from "ssse3-128"), and a warning when

@@ -100,7 +100,7 @@ struct Inst {
     std::vector<uint16_t> id_slots; // word indices of id operands, the result type's included, the result id's not
     spv::Op op() const { return spv::Op(words[0] & 0xffff); }
     uint32_t result = 0, type = 0;
-    bool glsl_ext = false;          // OpExtInst of GLSL.std.450
+    bool glsl_ext = false; // OpExtInst of GLSL.std.450
 };
 
 Inst make(spv::Op op, std::vector<uint32_t> operands, std::vector<uint16_t> id_slots, uint32_t type, uint32_t result) {
@@ -122,8 +122,8 @@ Module parse(const std::vector<uint32_t>& spirv) {
     Module m;
     spv_context ctx = spvContextCreate(SPV_ENV_UNIVERSAL_1_6);
     spv_diagnostic diag = nullptr;
-    auto on_header = [](void* user, spv_endianness_t, uint32_t magic, uint32_t version, uint32_t generator,
-                        uint32_t bound, uint32_t schema) -> spv_result_t {
+    auto on_header = [](void* user, spv_endianness_t, uint32_t magic, uint32_t version, uint32_t generator, uint32_t bound,
+                        uint32_t schema) -> spv_result_t {
         static_cast<Module*>(user)->header = {magic, version, generator, bound, schema};
         return SPV_SUCCESS;
     };
@@ -169,18 +169,39 @@ bool is_type_decl(spv::Op op) { return op >= spv::OpTypeVoid && op <= spv::OpTyp
 // Results that equal one of the operands (or an integer-valued fp16), hence are fp16 values already.
 bool is_exact(const Inst& i) {
     switch (i.op()) {
-    case spv::OpLoad: case spv::OpCompositeExtract: case spv::OpCompositeInsert: case spv::OpCompositeConstruct:
-    case spv::OpVectorShuffle: case spv::OpVectorExtractDynamic: case spv::OpVectorInsertDynamic:
-    case spv::OpCopyObject: case spv::OpCopyLogical: case spv::OpSelect: case spv::OpFNegate: case spv::OpUndef:
-    case spv::OpFunctionCall: case spv::OpPhi: case spv::OpVariable: case spv::OpFunctionParameter:
-        return true;
+    case spv::OpLoad:
+    case spv::OpCompositeExtract:
+    case spv::OpCompositeInsert:
+    case spv::OpCompositeConstruct:
+    case spv::OpVectorShuffle:
+    case spv::OpVectorExtractDynamic:
+    case spv::OpVectorInsertDynamic:
+    case spv::OpCopyObject:
+    case spv::OpCopyLogical:
+    case spv::OpSelect:
+    case spv::OpFNegate:
+    case spv::OpUndef:
+    case spv::OpFunctionCall:
+    case spv::OpPhi:
+    case spv::OpVariable:
+    case spv::OpFunctionParameter: return true;
     case spv::OpExtInst:
         if (!i.glsl_ext) return false;
         switch (GLSLstd450(i.words[4])) {
-        case GLSLstd450Round: case GLSLstd450RoundEven: case GLSLstd450Trunc: case GLSLstd450FAbs:
-        case GLSLstd450FSign: case GLSLstd450Floor: case GLSLstd450Ceil: case GLSLstd450FMin: case GLSLstd450FMax:
-        case GLSLstd450FClamp: case GLSLstd450Step: case GLSLstd450NMin: case GLSLstd450NMax: case GLSLstd450NClamp:
-            return true;
+        case GLSLstd450Round:
+        case GLSLstd450RoundEven:
+        case GLSLstd450Trunc:
+        case GLSLstd450FAbs:
+        case GLSLstd450FSign:
+        case GLSLstd450Floor:
+        case GLSLstd450Ceil:
+        case GLSLstd450FMin:
+        case GLSLstd450FMax:
+        case GLSLstd450FClamp:
+        case GLSLstd450Step:
+        case GLSLstd450NMin:
+        case GLSLstd450NMax:
+        case GLSLstd450NClamp: return true;
         default: return false;
         }
     default: return false;
@@ -228,8 +249,7 @@ bool emulate_fp16(std::vector<uint32_t>& spirv, Fp16EmulationStats* stats) {
         if (i.op() == spv::OpTypeFloat) half = i.result;
         if (i.op() == spv::OpTypeFloat || (i.op() == spv::OpTypeVector && half_values.count(t.component)))
             half_values.insert(i.result);
-        if (i.op() == spv::OpTypeMatrix)
-            throw ShaderCompileError("fp16 emulation: 16-bit float matrices are not supported");
+        if (i.op() == spv::OpTypeMatrix) throw ShaderCompileError("fp16 emulation: 16-bit float matrices are not supported");
         if (i.op() == spv::OpTypeImage || i.op() == spv::OpTypeSampledImage)
             throw ShaderCompileError("fp16 emulation: images with a 16-bit float sampled type cannot be widened");
         if (i.op() == spv::OpTypePointer) {
@@ -453,8 +473,7 @@ bool emulate_fp16(std::vector<uint32_t>& spirv, Fp16EmulationStats* stats) {
         // Structs and arrays may legally repeat (and carry their own decorations); pointers too, and
         // only those this pass made equal are merged.
         spv::Op op = i.op();
-        if (op == spv::OpTypeStruct || op == spv::OpTypeArray || op == spv::OpTypeRuntimeArray ||
-            op == spv::OpTypeForwardPointer)
+        if (op == spv::OpTypeStruct || op == spv::OpTypeArray || op == spv::OpTypeRuntimeArray || op == spv::OpTypeForwardPointer)
             continue;
         std::vector<uint32_t> key(i.words.begin(), i.words.end());
         key.erase(key.begin() + 1); // the result id
@@ -468,9 +487,8 @@ bool emulate_fp16(std::vector<uint32_t>& spirv, Fp16EmulationStats* stats) {
     for (Inst& i : out) {
         if (removed.count(i.result)) continue;
         spv::Op op = i.op();
-        bool annotates = op == spv::OpName || op == spv::OpMemberName || op == spv::OpDecorate ||
-                         op == spv::OpMemberDecorate || op == spv::OpDecorateId || op == spv::OpDecorateString ||
-                         op == spv::OpMemberDecorateString;
+        bool annotates = op == spv::OpName || op == spv::OpMemberName || op == spv::OpDecorate || op == spv::OpMemberDecorate ||
+                         op == spv::OpDecorateId || op == spv::OpDecorateString || op == spv::OpMemberDecorateString;
         if (annotates && removed.count(i.words[1])) continue;
         // precise (NoContraction) belongs to the arithmetic, which now carries the fresh id.
         if (op == spv::OpDecorate && i.words[2] == spv::DecorationNoContraction && renamed.count(i.words[1]))

@@ -17,7 +17,7 @@ enum class Fp16Path { native, emulated };
 // shaderFloat16, else emulated. native on a device without shaderFloat16 throws EnvironmentError
 // naming `device_name`; an unknown value throws UsageError.
 Fp16Path choose_fp16_path(const std::string& requested, bool device_has_float16, const std::string& device_name);
-const char* fp16_path_name(Fp16Path path);      // "native" | "emulated" (provenance)
+const char* fp16_path_name(Fp16Path path);        // "native" | "emulated" (provenance)
 std::string fp16_path_description(Fp16Path path); // one line for `iblcheck doctor`
 
 // What emulate_fp16 did (tests check it; zero everywhere when the module had no 16-bit float).

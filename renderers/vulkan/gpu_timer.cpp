@@ -28,7 +28,7 @@ void GpuTimer::begin(VkCommandBuffer cmd, const std::string& name) {
     if (names_.size() >= max_) throw Error("GpuTimer: more passes than reserved");
     const uint32_t q = uint32_t(kQueriesPerPass * names_.size());
     vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, pool_, q);
-    vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, pool_, q + 1);  // resolves q on lavapipe
+    vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, pool_, q + 1); // resolves q on lavapipe
     names_.push_back(name);
 }
 
@@ -44,8 +44,8 @@ std::vector<std::pair<std::string, double>> GpuTimer::results() const {
                                 VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
           "vkGetQueryPoolResults");
     for (size_t i = 0; i < names_.size(); ++i)
-        out.emplace_back(names_[i], double(ts[kQueriesPerPass * i + 2] - ts[kQueriesPerPass * i]) *
-                                        ctx_.info().timestamp_period_ns * 1e-6);
+        out.emplace_back(names_[i],
+                         double(ts[kQueriesPerPass * i + 2] - ts[kQueriesPerPass * i]) * ctx_.info().timestamp_period_ns * 1e-6);
     return out;
 }
 

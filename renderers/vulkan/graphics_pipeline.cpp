@@ -141,14 +141,14 @@ OffscreenTarget::OffscreenTarget(Context& ctx, uint32_t width, uint32_t height, 
     const bool msaa = format.samples != VK_SAMPLE_COUNT_1_BIT;
     try {
         VkImageUsageFlags color_usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT;
-        if (!msaa) color_usage |= VK_IMAGE_USAGE_TRANSFER_SRC_BIT;  // copied directly: nothing to resolve
+        if (!msaa) color_usage |= VK_IMAGE_USAGE_TRANSFER_SRC_BIT; // copied directly: nothing to resolve
         color_ = make_attachment(format.color, format.samples, color_usage, VK_IMAGE_ASPECT_COLOR_BIT);
-        depth_ = make_attachment(format.depth, format.samples, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT,
-                                 VK_IMAGE_ASPECT_DEPTH_BIT);
+        depth_ =
+            make_attachment(format.depth, format.samples, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, VK_IMAGE_ASPECT_DEPTH_BIT);
         if (msaa)
-            resolve_ = make_attachment(format.color, VK_SAMPLE_COUNT_1_BIT,
-                                       VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
-                                       VK_IMAGE_ASPECT_COLOR_BIT);
+            resolve_ =
+                make_attachment(format.color, VK_SAMPLE_COUNT_1_BIT,
+                                VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT, VK_IMAGE_ASPECT_COLOR_BIT);
         render_pass_ = create_render_pass(ctx.device(), format);
         VkImageView views[3] = {color_.view, depth_.view, resolve_.view};
         auto fci = vk_struct<VkFramebufferCreateInfo>(VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO);
@@ -214,8 +214,9 @@ GraphicsPipeline::GraphicsPipeline(Context& ctx, const GraphicsPipelineDesc& d) 
     VkDevice dev = ctx.device();
     counts_ = d.vertex->counts_instructions || d.fragment->counts_instructions;
     if (counts_ && !ctx.info().graphics_stores)
-        throw EnvironmentError(ctx.info().device_name +
-                               ": counting a draw's instructions needs vertexPipelineStoresAndAtomics and fragmentStoresAndAtomics");
+        throw EnvironmentError(
+            ctx.info().device_name +
+            ": counting a draw's instructions needs vertexPipelineStoresAndAtomics and fragmentStoresAndAtomics");
     std::vector<VkDescriptorSetLayoutBinding> lb;
     for (uint32_t i = 0; i < d.bindings.size(); ++i) lb.push_back({i, d.bindings[i], 1, kStages, nullptr});
     if (counts_ && d.bindings.size() > kCostBinding)
@@ -262,14 +263,14 @@ GraphicsPipeline::GraphicsPipeline(Context& ctx, const GraphicsPipelineDesc& d) 
         rs.lineWidth = 1.0f;
         auto ms = vk_struct<VkPipelineMultisampleStateCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO);
         ms.rasterizationSamples = d.target.samples;
-        ms.sampleShadingEnable = VK_FALSE;  // MSAA: one shading per pixel, coverage per sample
+        ms.sampleShadingEnable = VK_FALSE; // MSAA: one shading per pixel, coverage per sample
         auto ds = vk_struct<VkPipelineDepthStencilStateCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO);
         ds.depthTestEnable = d.depth_test;
         ds.depthWriteEnable = d.depth_test;
         ds.depthCompareOp = VK_COMPARE_OP_LESS;
         VkPipelineColorBlendAttachmentState blend{};
-        blend.colorWriteMask = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT | VK_COLOR_COMPONENT_B_BIT |
-                               VK_COLOR_COMPONENT_A_BIT;
+        blend.colorWriteMask =
+            VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT | VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT;
         auto cb = vk_struct<VkPipelineColorBlendStateCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO);
         cb.attachmentCount = 1;
         cb.pAttachments = &blend;
@@ -315,8 +316,8 @@ void GraphicsPipeline::release() {
     set_layout_ = VK_NULL_HANDLE;
 }
 
-void GraphicsPipeline::draw(VkCommandBuffer cmd, const std::vector<Binding>& bindings, const void* push,
-                            uint32_t push_bytes, uint32_t vertex_count, uint32_t instance_count) const {
+void GraphicsPipeline::draw(VkCommandBuffer cmd, const std::vector<Binding>& bindings, const void* push, uint32_t push_bytes,
+                            uint32_t vertex_count, uint32_t instance_count) const {
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline_);
     ctx_.push_descriptors(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, layout_, bindings);
     if (push && push_bytes) vkCmdPushConstants(cmd, layout_, kStages, 0, push_bytes, push);

@@ -51,7 +51,7 @@ class OffscreenTarget {
     Attachment make_attachment(VkFormat format, VkSampleCountFlagBits samples, VkImageUsageFlags usage,
                                VkImageAspectFlags aspect);
     void destroy(Attachment& a);
-    void release();  // everything created so far (the destructor, and a constructor that throws)
+    void release(); // everything created so far (the destructor, and a constructor that throws)
 
     Context& ctx_;
     uint32_t width_, height_;
@@ -64,11 +64,11 @@ class OffscreenTarget {
 struct GraphicsPipelineDesc {
     const CompiledShader* vertex = nullptr;
     const CompiledShader* fragment = nullptr;
-    std::vector<VkDescriptorType> bindings;  // binding i's type; visible to both stages
-    uint32_t push_constant_bytes = 0;        // one range, both stages
+    std::vector<VkDescriptorType> bindings; // binding i's type; visible to both stages
+    uint32_t push_constant_bytes = 0;       // one range, both stages
     TargetFormat target;
     VkPrimitiveTopology topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_STRIP;
-    bool depth_test = true;                  // less, with writes
+    bool depth_test = true; // less, with writes
 };
 
 class GraphicsPipeline {
@@ -92,7 +92,7 @@ class GraphicsPipeline {
     Context& ctx_;
     VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
     VkPipelineLayout layout_ = VK_NULL_HANDLE;
-    VkRenderPass render_pass_ = VK_NULL_HANDLE;  // compatible with every OffscreenTarget of the format
+    VkRenderPass render_pass_ = VK_NULL_HANDLE; // compatible with every OffscreenTarget of the format
     VkPipeline pipeline_ = VK_NULL_HANDLE;
     bool counts_ = false;
 };

@@ -20,8 +20,8 @@ Buffer Context::create_buffer(VkDeviceSize size, VkBufferUsageFlags usage) {
     vkGetBufferMemoryRequirements(device_, b.buffer, &req);
     auto ai = vk_struct<VkMemoryAllocateInfo>(VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO);
     ai.allocationSize = req.size;
-    ai.memoryTypeIndex = find_memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT |
-                                                                  VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
+    ai.memoryTypeIndex =
+        find_memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
     check(vkAllocateMemory(device_, &ai, nullptr, &b.memory), "vkAllocateMemory");
     check(vkBindBufferMemory(device_, b.buffer, b.memory, 0), "vkBindBufferMemory");
     check(vkMapMemory(device_, b.memory, 0, VK_WHOLE_SIZE, 0, &b.mapped), "vkMapMemory");
@@ -140,12 +140,11 @@ void Context::end_and_wait(VkCommandBuffer cmd) {
 void Context::barrier(VkCommandBuffer cmd) {
     auto mb = vk_struct<VkMemoryBarrier>(VK_STRUCTURE_TYPE_MEMORY_BARRIER);
     mb.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
-    mb.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT |
-                       VK_ACCESS_HOST_READ_BIT;
+    mb.dstAccessMask =
+        VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_HOST_READ_BIT;
     vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
-                         VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT |
-                             VK_PIPELINE_STAGE_HOST_BIT,
-                         0, 1, &mb, 0, nullptr, 0, nullptr);
+                         VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_HOST_BIT, 0, 1,
+                         &mb, 0, nullptr, 0, nullptr);
 }
 
 void Context::transition(VkCommandBuffer cmd, const Image& img, VkImageLayout from, VkImageLayout to) {
@@ -158,8 +157,7 @@ void Context::transition(VkCommandBuffer cmd, const Image& img, VkImageLayout fr
     b.image = img.image;
     b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, img.mips, 0, img.layers};
     vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
-                         VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr, 0,
-                         nullptr, 1, &b);
+                         VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr, 0, nullptr, 1, &b);
 }
 
 void Context::copy_buffer_to_image(VkCommandBuffer cmd, const Buffer& src, const Image& dst, uint32_t mip) {
@@ -173,10 +171,14 @@ namespace {
 float half_to_float(uint16_t h) {
     uint32_t sign = uint32_t(h >> 15) << 31, exp = (h >> 10) & 0x1f, mant = h & 0x3ff, bits;
     if (exp == 0) {
-        if (mant == 0) bits = sign;
-        else {  // subnormal
+        if (mant == 0)
+            bits = sign;
+        else { // subnormal
             int e = -1;
-            do { ++e; mant <<= 1; } while (!(mant & 0x400));
+            do {
+                ++e;
+                mant <<= 1;
+            } while (!(mant & 0x400));
             bits = sign | uint32_t(127 - 15 - e) << 23 | (mant & 0x3ff) << 13;
         }
     } else if (exp == 31) {
@@ -193,8 +195,10 @@ float half_to_float(uint16_t h) {
 std::vector<float> Context::download(const Image& img, uint32_t mip) {
     uint32_t w = std::max(1u, img.width >> mip), h = std::max(1u, img.height >> mip);
     size_t texels = size_t(w) * h * img.layers;
-    size_t bpp = img.format == VK_FORMAT_R32G32B32A32_SFLOAT ? 16 : img.format == VK_FORMAT_R16G16B16A16_SFLOAT ? 8
-               : img.format == VK_FORMAT_R16G16_SFLOAT ? 4 : 0;
+    size_t bpp = img.format == VK_FORMAT_R32G32B32A32_SFLOAT   ? 16
+                 : img.format == VK_FORMAT_R16G16B16A16_SFLOAT ? 8
+                 : img.format == VK_FORMAT_R16G16_SFLOAT       ? 4
+                                                               : 0;
     if (!bpp) throw Error("Context::download: unsupported image format");
     Buffer buf = create_buffer(texels * bpp, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
     submit([&](VkCommandBuffer cmd) {

@@ -13,7 +13,7 @@
 #include <sstream>
 
 #include "fp16_emulation.h"
-#include "fp16_pass_hash.h"  // generated: IBLCHECK_FP16_PASS_HASH
+#include "fp16_pass_hash.h" // generated: IBLCHECK_FP16_PASS_HASH
 #include "harness/common/errors.h"
 #include "harness/common/hash.h"
 #include "spirv_cost.h"
@@ -89,8 +89,7 @@ std::string format_log(const std::string& log) {
         if (std::regex_search(line, m, err)) {
             if (m[1] == "WARNING") continue;
             out += m[2].str() + ":" + m[3].str() + ": " + m[4].str() + "\n";
-        } else if (line.find("ERROR:") != std::string::npos &&
-                   line.find("compilation errors") == std::string::npos) {
+        } else if (line.find("ERROR:") != std::string::npos && line.find("compilation errors") == std::string::npos) {
             out += line + "\n";
         }
     }
@@ -137,7 +136,7 @@ std::string shader_tree_hash() {
 namespace {
 struct Stage {
     EShLanguage language;
-    const char* key;  // part of the cache key; "comp" as before graphics stages existed
+    const char* key; // part of the cache key; "comp" as before graphics stages existed
 };
 Stage stage_of(const fs::path& path) {
     std::string ext = path.extension().string();
@@ -147,8 +146,7 @@ Stage stage_of(const fs::path& path) {
     throw ShaderCompileError(path.string() + ": unknown shader stage (expected .comp, .vert or .frag)");
 }
 
-CompiledShader compile_stage_file(const fs::path& path_in, Stage stage, const Defines& defines,
-                                  const CompileOptions& options);
+CompiledShader compile_stage_file(const fs::path& path_in, Stage stage, const Defines& defines, const CompileOptions& options);
 } // namespace
 
 CompiledShader compile_compute_shader(const std::string& name, const Defines& defines, const CompileOptions& options) {
@@ -157,8 +155,7 @@ CompiledShader compile_compute_shader(const std::string& name, const Defines& de
     return compile_compute_shader_file(p, defines, options);
 }
 
-CompiledShader compile_compute_shader_file(const fs::path& path_in, const Defines& defines,
-                                           const CompileOptions& options) {
+CompiledShader compile_compute_shader_file(const fs::path& path_in, const Defines& defines, const CompileOptions& options) {
     return compile_stage_file(path_in, {EShLangCompute, "comp"}, defines, options);
 }
 
@@ -173,8 +170,7 @@ CompiledShader compile_shader_file(const fs::path& path, const Defines& defines,
 }
 
 namespace {
-CompiledShader compile_stage_file(const fs::path& path_in, Stage stage, const Defines& defines,
-                                  const CompileOptions& options) {
+CompiledShader compile_stage_file(const fs::path& path_in, Stage stage, const Defines& defines, const CompileOptions& options) {
     fs::path path = fs::weakly_canonical(path_in);
     Fnv1a64 h;
     h.update(std::string(stage.key) + ";glslang-vulkan1.2;");
@@ -226,7 +222,7 @@ CompiledShader compile_stage_file(const fs::path& path_in, Stage stage, const De
         program.addShader(&shader);
         if (!program.link(msgs)) throw ShaderCompileError(name + ": link: " + format_log(program.getInfoLog()));
         glslang::SpvOptions opt;
-        opt.disableOptimizer = true;  // lavapipe's LLVM optimises; keep SPIR-V faithful to the source
+        opt.disableOptimizer = true; // lavapipe's LLVM optimises; keep SPIR-V faithful to the source
         glslang::GlslangToSpv(*program.getIntermediate(stage.language), out.spirv, &opt);
     }
     // The count comes before the fp16 emulation: it measures the shader as written (what a device

@@ -39,8 +39,7 @@ std::filesystem::path shader_dir();
 
 // Compiles the compute shader `name` (a file under shader_dir(), e.g. "prefilter_ggx.comp").
 // Throws ShaderCompileError whose message starts "file:line: " for every error glslang reports.
-CompiledShader compile_compute_shader(const std::string& name, const Defines& defines = {},
-                                      const CompileOptions& options = {});
+CompiledShader compile_compute_shader(const std::string& name, const Defines& defines = {}, const CompileOptions& options = {});
 
 // Same, for a full path (tests compile shaders from temporary folders).
 CompiledShader compile_compute_shader_file(const std::filesystem::path& path, const Defines& defines = {},

@@ -50,15 +50,29 @@ bool is_debug_line(spv::Op op) { return op == spv::OpLine || op == spv::OpNoLine
 // follows them, up to the first OpFunction, is types, constants and global variables.
 bool in_preamble(spv::Op op) {
     switch (op) {
-    case spv::OpCapability: case spv::OpExtension: case spv::OpExtInstImport: case spv::OpMemoryModel:
-    case spv::OpEntryPoint: case spv::OpExecutionMode: case spv::OpExecutionModeId: case spv::OpString:
-    case spv::OpSourceExtension: case spv::OpSource: case spv::OpSourceContinued: case spv::OpName:
-    case spv::OpMemberName: case spv::OpModuleProcessed: case spv::OpDecorate: case spv::OpMemberDecorate:
-    case spv::OpDecorationGroup: case spv::OpGroupDecorate: case spv::OpGroupMemberDecorate:
-    case spv::OpDecorateId: case spv::OpDecorateString: case spv::OpMemberDecorateString:
-        return true;
-    default:
-        return false;
+    case spv::OpCapability:
+    case spv::OpExtension:
+    case spv::OpExtInstImport:
+    case spv::OpMemoryModel:
+    case spv::OpEntryPoint:
+    case spv::OpExecutionMode:
+    case spv::OpExecutionModeId:
+    case spv::OpString:
+    case spv::OpSourceExtension:
+    case spv::OpSource:
+    case spv::OpSourceContinued:
+    case spv::OpName:
+    case spv::OpMemberName:
+    case spv::OpModuleProcessed:
+    case spv::OpDecorate:
+    case spv::OpMemberDecorate:
+    case spv::OpDecorationGroup:
+    case spv::OpGroupDecorate:
+    case spv::OpGroupMemberDecorate:
+    case spv::OpDecorateId:
+    case spv::OpDecorateString:
+    case spv::OpMemberDecorateString: return true;
+    default: return false;
     }
 }
 
@@ -74,7 +88,7 @@ std::vector<Block> blocks_of_function(const std::vector<Inst>& insts, size_t fn_
     size_t i = fn_begin + 1;
     while (i < insts.size() && opcode(insts[i]) != spv::OpFunctionEnd) {
         if (opcode(insts[i]) != spv::OpLabel) {
-            ++i;  // OpFunctionParameter (or a stray debug line before the first label)
+            ++i; // OpFunctionParameter (or a stray debug line before the first label)
             continue;
         }
         size_t j = i + 1;
@@ -200,8 +214,8 @@ std::vector<uint32_t> instrument_instruction_count(const std::vector<uint32_t>& 
             std::string str(s);
             str.resize((str.size() / 4 + 1) * 4, '\0');
             for (size_t k = 0; k < str.size(); k += 4)
-                i.push_back(uint32_t(uint8_t(str[k])) | uint32_t(uint8_t(str[k + 1])) << 8 |
-                            uint32_t(uint8_t(str[k + 2])) << 16 | uint32_t(uint8_t(str[k + 3])) << 24);
+                i.push_back(uint32_t(uint8_t(str[k])) | uint32_t(uint8_t(str[k + 1])) << 8 | uint32_t(uint8_t(str[k + 2])) << 16 |
+                            uint32_t(uint8_t(str[k + 3])) << 24);
             i[0] = uint32_t(i.size()) << 16 | spv::OpName;
             names_add.push_back(i);
         };
@@ -230,7 +244,8 @@ std::vector<uint32_t> instrument_instruction_count(const std::vector<uint32_t>& 
     // The function bodies, rewritten block by block.
     std::vector<Inst> body;
     for (size_t i = first_function; i < m.insts.size(); ++i) {
-        if (opcode(m.insts[i]) != spv::OpFunction) throw Error("SPIR-V instrumentation: unexpected instruction between functions");
+        if (opcode(m.insts[i]) != spv::OpFunction)
+            throw Error("SPIR-V instrumentation: unexpected instruction between functions");
         bool entry = entry_functions.count(m.insts[i][2]) > 0;
         size_t end = i;
         std::vector<Block> blocks = blocks_of_function(m.insts, i, end);

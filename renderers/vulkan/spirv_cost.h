@@ -24,7 +24,7 @@ namespace iblcheck::vk {
 // Descriptor set 0 binding of the counter buffer (a single uint64): the shaders use 0..5.
 inline constexpr uint32_t kCostBinding = 15;
 // Part of the SPIR-V cache key of instrumented shaders: bump it when the pass's output changes.
-inline constexpr int kCostPassVersion = 2;  // 2: counted before the fp16 emulation
+inline constexpr int kCostPassVersion = 2; // 2: counted before the fp16 emulation
 
 // A block's static instruction count: every instruction from the one after its OpLabel to its
 // terminator, both included, except OpLine/OpNoLine (debug annotations). OpPhi, OpVariable and
@@ -51,7 +51,6 @@ std::vector<std::vector<uint32_t>> block_instruction_counts(const std::vector<ui
 // with `bindings` plus a fresh counter buffer at kCostBinding, waits, and returns the SPIR-V
 // instructions the dispatch executed, summed over every invocation.
 uint64_t count_dispatch_instructions(Context& ctx, const ComputePipeline& counted, std::vector<Binding> bindings,
-                                     const void* push, uint32_t push_bytes, uint32_t gx, uint32_t gy = 1,
-                                     uint32_t gz = 1);
+                                     const void* push, uint32_t push_bytes, uint32_t gx, uint32_t gy = 1, uint32_t gz = 1);
 
 } // namespace iblcheck::vk
