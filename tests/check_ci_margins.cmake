@@ -1,0 +1,33 @@
+# Issue 15: no ci tolerance may sit within 3x of the cross-CPU noise floor. Runs
+#   iblcheck run --suite ci --stability --out OUT
+# (each test rendered again under GALLIUM_OVERRIDE_CPU_CAPS=avx and sse4.1) and fails naming every
+# test the run marks flaky (a margin under the suite's min_margin), with its smallest margin.
+#   cmake -DIBLCHECK=path/to/iblcheck -DOUT=dir -P check_ci_margins.cmake
+file(REMOVE_RECURSE "${OUT}")
+execute_process(COMMAND "${IBLCHECK}" run --suite ci --stability --out "${OUT}" -q RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "iblcheck run --suite ci --stability exited ${rc}")
+endif()
+file(READ "${OUT}/results.json" results)
+string(JSON n LENGTH "${results}" tests)
+if(n EQUAL 0)
+  message(FATAL_ERROR "${OUT}/results.json: no tests")
+endif()
+math(EXPR last "${n} - 1")
+set(flaky "")
+foreach(i RANGE ${last})
+  string(JSON name GET "${results}" tests ${i} name)
+  string(JSON is_flaky ERROR_VARIABLE err GET "${results}" tests ${i} stability flaky)
+  if(err)
+    message(FATAL_ERROR "${OUT}/results.json: tests[${i}] (${name}): no stability.flaky")
+  endif()
+  if(is_flaky)
+    string(JSON metric GET "${results}" tests ${i} stability smallest_margin metric)
+    string(JSON margin GET "${results}" tests ${i} stability smallest_margin margin)
+    string(APPEND flaky "\n  ${name}: ${metric} margin ${margin}")
+  endif()
+endforeach()
+if(flaky)
+  message(FATAL_ERROR "ci tolerances within 3x of the cross-CPU floor:${flaky}")
+endif()
+message(STATUS "${n} ci tests, every margin >= the suite's min_margin")
