@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <functional>
 #include <iterator>
 #include <set>
 
@@ -59,29 +60,30 @@ std::string point_label(const json& t) {
     return v.empty() || v == "default" ? str(t, "method") == "mobile" ? "default" : str(t, "method") : v;
 }
 
-// Cost (x) against accuracy (y) for one scene and environment.
-// `method`: only that method's tests (its variants side by side, on a linear axis that starts near
-// them: they differ by a few percent); empty: every method (log axis when the costs span > 3x).
-std::string cost_panel(const std::string& id, const std::string& title, const std::vector<const json*>& tests,
-                       const std::vector<size_t>& page, Markers& markers, const std::string& method = "") {
+// Accuracy (y: mean FLIP vs the truth) against one per-test figure (x) for one scene and
+// environment: one series per method and variant family, coloured by method, marked by family.
+// `x_of` gives a test's x (nullopt or <= 0: not drawn); `detail` completes a point (its tooltip's
+// x part, an optional range). Returns the chart with the points' x values in `xs`.
+Chart accuracy_chart(const std::string& id, const std::string& title, ChartAxis x_axis, bool pareto,
+                     const std::vector<const json*>& tests, const std::vector<size_t>& page, Markers& markers,
+                     const std::function<std::optional<double>(const json&)>& x_of,
+                     const std::function<std::string(const json&, ChartPoint&)>& detail, std::vector<double>& xs) {
     Chart c;
     c.id = id;
     c.title = title;
     c.width = 440;
     c.plot_height = 230;
     c.legend = false;
-    c.pareto = true;
-    c.x = {"SPIR-V instructions executed per pixel (deterministic)", false, {}, {}};
+    c.pareto = pareto;
+    c.x = std::move(x_axis);
     c.y = {"mean FLIP vs the truth", false, {}, {}};
     std::map<std::pair<std::string, std::string>, size_t> series;
-    std::vector<double> xs;
     for (size_t k = 0; k < tests.size(); ++k) {
         const json& t = *tests[k];
         auto f = num(sub(t, "accuracy"), "flip_mean");
-        auto x = num(sub(t, "cost"), "spirv_instructions_per_pixel");
+        auto x = x_of(t);
         if (!f || !x || *x <= 0) continue;
         const std::string m = str(t, "method"), fam = variant_family(t);
-        if (!method.empty() && m != method) continue;
         auto key = std::pair{m, fam};
         if (!series.count(key)) {
             series[key] = c.series.size();
@@ -94,12 +96,27 @@ std::string cost_panel(const std::string& id, const std::string& title, const st
         p.x = *x;
         p.y = *f;
         p.label = point_label(t);
-        p.tooltip =
-            fmt::format("{}\n{} SPIR-V instructions/pixel, mean FLIP vs the truth {}", str(t, "name"), fmt_num(*x), fmt_num(*f));
+        p.tooltip = fmt::format("{}\n{}, mean FLIP vs the truth {}", str(t, "name"), detail(t, p), fmt_num(*f));
         p.href = "#" + test_id(page[k]);
         c.series[series[key]].points.push_back(std::move(p));
         xs.push_back(*x);
     }
+    return c;
+}
+
+// Cost (x) against accuracy (y) for one scene and environment.
+// `method`: only that method's tests (its variants side by side, on a linear axis that starts near
+// them: they differ by a few percent); empty: every method (log axis when the costs span > 3x).
+std::string cost_panel(const std::string& id, const std::string& title, const std::vector<const json*>& tests,
+                       const std::vector<size_t>& page, Markers& markers, const std::string& method = "") {
+    std::vector<double> xs;
+    Chart c = accuracy_chart(
+        id, title, {"SPIR-V instructions executed per pixel (deterministic)", false, {}, {}}, true, tests, page, markers,
+        [&](const json& t) -> std::optional<double> {
+            if (!method.empty() && str(t, "method") != method) return std::nullopt;
+            return num(sub(t, "cost"), "spirv_instructions_per_pixel");
+        },
+        [](const json&, ChartPoint& p) { return fmt::format("{} SPIR-V instructions/pixel", fmt_num(p.x)); }, xs);
     if (xs.size() < 2) return "";
     auto [mn, mx] = std::minmax_element(xs.begin(), xs.end());
     if (method.empty()) {
@@ -117,90 +134,38 @@ std::string cost_panel(const std::string& id, const std::string& title, const st
 // layouts). Bytes are deterministic, so the front is drawn.
 std::string bytes_panel(const std::string& id, const std::string& title, const std::vector<const json*>& tests,
                         const std::vector<size_t>& page, Markers& markers) {
-    Chart c;
-    c.id = id;
-    c.title = title;
-    c.width = 440;
-    c.plot_height = 230;
-    c.legend = false;
-    c.pareto = true;
-    c.x = {"environment texture, bytes (storage format, all levels)", true, {}, {}};
-    c.y = {"mean FLIP vs the truth", false, {}, {}};
-    std::map<std::pair<std::string, std::string>, size_t> series;
-    size_t n = 0;
-    for (size_t k = 0; k < tests.size(); ++k) {
-        const json& t = *tests[k];
-        auto f = num(sub(t, "accuracy"), "flip_mean");
-        auto x = num(t, "texture_bytes");
-        if (!f || !x || *x <= 0) continue;
-        const std::string m = str(t, "method"), fam = variant_family(t);
-        auto key = std::pair{m, fam};
-        if (!series.count(key)) {
-            series[key] = c.series.size();
-            ChartSeries s = make_series(m + " \u00b7 " + fam, method_color(m));
-            s.marker = markers.of(fam).shape;
-            s.hollow = markers.of(fam).hollow;
-            c.series.push_back(std::move(s));
-        }
-        ChartPoint p;
-        p.x = *x;
-        p.y = *f;
-        p.label = point_label(t);
-        const auto texels = num(t, "texel_count");
-        p.tooltip = fmt::format("{}\n{} bytes{}, mean FLIP vs the truth {}", str(t, "name"), fmt_num(*x),
-                                texels ? fmt::format(" ({} texels)", fmt_num(*texels)) : std::string(), fmt_num(*f));
-        p.href = "#" + test_id(page[k]);
-        c.series[series[key]].points.push_back(std::move(p));
-        ++n;
-    }
-    return n < 2 ? "" : render_chart(c);
+    std::vector<double> xs;
+    Chart c = accuracy_chart(
+        id, title, {"environment texture, bytes (storage format, all levels)", true, {}, {}}, true, tests, page, markers,
+        [](const json& t) { return num(t, "texture_bytes"); },
+        [](const json& t, ChartPoint& p) {
+            const auto texels = num(t, "texel_count");
+            return fmt::format("{} bytes{}", fmt_num(p.x),
+                               texels ? fmt::format(" ({} texels)", fmt_num(*texels)) : std::string());
+        },
+        xs);
+    return xs.size() < 2 ? "" : render_chart(c);
 }
 
 // Wall time: median with the range of the repeated timings (x), accuracy (y); no front.
 std::string wall_panel(const std::string& id, const std::string& title, const std::vector<const json*>& tests,
                        const std::vector<size_t>& page, Markers& markers) {
-    Chart c;
-    c.id = id;
-    c.title = title;
-    c.width = 440;
-    c.plot_height = 230;
-    c.legend = false;
-    c.x = {"frame ms: median, bar: range of the repeats", true, {}, {}};
-    c.y = {"mean FLIP vs the truth", false, {}, {}};
-    std::map<std::pair<std::string, std::string>, size_t> series;
-    size_t n = 0;
-    for (size_t k = 0; k < tests.size(); ++k) {
-        const json& t = *tests[k];
-        auto f = num(sub(t, "accuracy"), "flip_mean");
-        auto x = num(t, "frame_ms");
-        if (!f || !x || *x <= 0) continue;
-        const std::string m = str(t, "method"), fam = variant_family(t);
-        auto key = std::pair{m, fam};
-        if (!series.count(key)) {
-            series[key] = c.series.size();
-            ChartSeries s = make_series(m + " \u00b7 " + fam, method_color(m));
-            s.marker = markers.of(fam).shape;
-            s.hollow = markers.of(fam).hollow;
-            c.series.push_back(std::move(s));
-        }
-        ChartPoint p;
-        p.x = *x;
-        p.y = *f;
-        const json& smp = sub(t, "frame_ms_samples");
-        std::string spread = "one timing";
-        if (smp.is_array() && smp.size() > 1 && smp.front().is_number() && smp.back().is_number()) {
-            p.xlo = smp.front().get<double>();
-            p.xhi = smp.back().get<double>();
-            spread = fmt::format("median of {}, range {}\u2013{} ms", smp.size(), fmt_num(*p.xlo), fmt_num(*p.xhi));
-        }
-        p.label = point_label(t);
-        p.tooltip =
-            fmt::format("{}\nframe {} ms ({}), mean FLIP vs the truth {}", str(t, "name"), fmt_num(*x), spread, fmt_num(*f));
-        p.href = "#" + test_id(page[k]);
-        c.series[series[key]].points.push_back(std::move(p));
-        ++n;
-    }
-    return n < 2 ? "" : render_chart(c);
+    std::vector<double> xs;
+    Chart c = accuracy_chart(
+        id, title, {"frame ms: median, bar: range of the repeats", true, {}, {}}, false, tests, page, markers,
+        [](const json& t) { return num(t, "frame_ms"); },
+        [](const json& t, ChartPoint& p) {
+            const json& smp = sub(t, "frame_ms_samples");
+            std::string spread = "one timing";
+            if (smp.is_array() && smp.size() > 1 && smp.front().is_number() && smp.back().is_number()) {
+                p.xlo = smp.front().get<double>();
+                p.xhi = smp.back().get<double>();
+                spread = fmt::format("median of {}, range {}\u2013{} ms", smp.size(), fmt_num(*p.xlo), fmt_num(*p.xhi));
+            }
+            return fmt::format("frame {} ms ({})", fmt_num(p.x), spread);
+        },
+        xs);
+    return xs.size() < 2 ? "" : render_chart(c);
 }
 
 // Error against roughness for one environment and one variant family: the family's variants
