@@ -70,29 +70,6 @@ void rgbm_encode(const float rgb[3], float range, float out[4]) {
     out[3] = m;
 }
 
-float half_bits_to_float(uint16_t h) {
-    uint32_t sign = uint32_t(h >> 15) << 31, exp = (h >> 10) & 0x1f, mant = h & 0x3ff, bits;
-    if (exp == 0) {
-        if (mant == 0)
-            bits = sign;
-        else { // subnormal: normalise the mantissa
-            int e = -1;
-            do {
-                ++e;
-                mant <<= 1;
-            } while (!(mant & 0x400));
-            bits = sign | uint32_t(127 - 15 - e) << 23 | (mant & 0x3ff) << 13;
-        }
-    } else if (exp == 31) {
-        bits = sign | 0x7f800000u | mant << 13;
-    } else {
-        bits = sign | (exp + 112) << 23 | mant << 13;
-    }
-    float f;
-    std::memcpy(&f, &bits, 4);
-    return f;
-}
-
 AstcCodec::AstcCodec(const AstcFormat& format) : format_(format) {
     if (format.block != 4 && format.block != 6)
         throw UsageError("option 'astc_block': " + std::to_string(format.block) + "x" + std::to_string(format.block) +

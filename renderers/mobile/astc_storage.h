@@ -15,6 +15,8 @@
 #include <string>
 #include <vector>
 
+#include "renderers/vulkan/half_float.h" // half_bits_to_float: the decoded blocks are fp16
+
 struct astcenc_context; // astcenc.h (kept out of this header)
 
 namespace iblcheck {
@@ -72,8 +74,5 @@ class AstcCodec {
     AstcFormat format_;
     ::astcenc_context* ctx_ = nullptr;
 };
-
-// fp16 bit pattern → float (IEEE binary16, subnormals included).
-float half_bits_to_float(uint16_t h);
 
 } // namespace iblcheck

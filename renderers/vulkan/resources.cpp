@@ -3,6 +3,7 @@
 #include <cstring>
 
 #include "context.h"
+#include "half_float.h"
 #include "harness/common/errors.h"
 #include "vk_struct.h"
 
@@ -167,31 +168,6 @@ void Context::copy_buffer_to_image(VkCommandBuffer cmd, const Buffer& src, const
     vkCmdCopyBufferToImage(cmd, src.buffer, dst.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &r);
 }
 
-namespace {
-float half_to_float(uint16_t h) {
-    uint32_t sign = uint32_t(h >> 15) << 31, exp = (h >> 10) & 0x1f, mant = h & 0x3ff, bits;
-    if (exp == 0) {
-        if (mant == 0)
-            bits = sign;
-        else { // subnormal
-            int e = -1;
-            do {
-                ++e;
-                mant <<= 1;
-            } while (!(mant & 0x400));
-            bits = sign | uint32_t(127 - 15 - e) << 23 | (mant & 0x3ff) << 13;
-        }
-    } else if (exp == 31) {
-        bits = sign | 0x7f800000u | mant << 13;
-    } else {
-        bits = sign | (exp + 112) << 23 | mant << 13;
-    }
-    float f;
-    std::memcpy(&f, &bits, 4);
-    return f;
-}
-} // namespace
-
 std::vector<float> Context::download(const Image& img, uint32_t mip) {
     uint32_t w = std::max(1u, img.width >> mip), h = std::max(1u, img.height >> mip);
     size_t texels = size_t(w) * h * img.layers;
@@ -216,10 +192,10 @@ std::vector<float> Context::download(const Image& img, uint32_t mip) {
         const uint16_t* hp = static_cast<const uint16_t*>(buf.mapped);
         for (size_t i = 0; i < texels; ++i) {
             if (bpp == 8)
-                for (int c = 0; c < 4; ++c) out[4 * i + c] = half_to_float(hp[4 * i + c]);
+                for (int c = 0; c < 4; ++c) out[4 * i + c] = half_bits_to_float(hp[4 * i + c]);
             else {
-                out[4 * i] = half_to_float(hp[2 * i]);
-                out[4 * i + 1] = half_to_float(hp[2 * i + 1]);
+                out[4 * i] = half_bits_to_float(hp[2 * i]);
+                out[4 * i + 1] = half_bits_to_float(hp[2 * i + 1]);
                 out[4 * i + 2] = 0;
                 out[4 * i + 3] = 1;
             }
