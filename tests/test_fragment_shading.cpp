@@ -16,20 +16,12 @@
 #include "renderers/mobile/mobile_renderer.h"
 #include "renderers/renderer.h"
 #include "renderers/scenes/scene.h"
+#include "tests/gpu_test_support.h"
 
 using namespace iblcheck;
+using namespace iblcheck::testutil;
 
 namespace {
-
-GpuSession& session() {
-    static GpuSession s(vk::ContextOptions{"", true});
-    return s;
-}
-
-void expect_no_validation_errors() {
-    auto& ctx = session().ctx();
-    EXPECT_EQ(ctx.validation_errors(), 0) << (ctx.validation_messages().empty() ? "" : ctx.validation_messages()[0]);
-}
 
 TestSpec spec(const std::string& scene, const std::string& env, std::vector<std::pair<std::string, std::string>> opts = {}) {
     TestSpec s;

@@ -22,23 +22,15 @@
 #include "renderers/renderer.h"
 #include "renderers/sampled/sampled_renderer.h"
 #include "renderers/scenes/scene.h"
+#include "tests/gpu_test_support.h"
 #include "tests/test_support.h"
 
 using namespace iblcheck;
+using namespace iblcheck::testutil;
 
 namespace {
 
 using namespace iblcheck::testutil;
-
-GpuSession& session() {
-    static GpuSession s(vk::ContextOptions{"", true});
-    return s;
-}
-
-void expect_no_validation_errors() {
-    auto& ctx = session().ctx();
-    EXPECT_EQ(ctx.validation_errors(), 0) << (ctx.validation_messages().empty() ? "" : ctx.validation_messages()[0]);
-}
 
 TestSpec spec(const std::string& scene, const std::string& env, std::vector<std::pair<std::string, std::string>> opts = {}) {
     TestSpec s;
@@ -53,35 +45,6 @@ RenderResult render(const TestSpec& s) {
     validate_spec(s);
     Environment env = load_environment(s.env);
     return render_mobile(session(), env, s);
-}
-
-// Sphere index under each pixel centre (−1: background), and whether the pixel's 3×3
-// neighbourhood is the same sphere (an interior pixel: no silhouette mixing).
-struct PixelInfo {
-    int sphere = -1;
-    bool interior = false;
-    Vec3f normal;
-};
-std::vector<PixelInfo> pixel_info(const TestSpec& s, int w, int h) {
-    Scene scene = build_scene(s.scene, s.options);
-    std::vector<PixelInfo> info(size_t(w) * h);
-    for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x) {
-            Vec3f o, d;
-            camera_ray(scene, w, h, x + 0.5, y + 0.5, o, d);
-            Hit hit = intersect(scene, o, d);
-            info[size_t(y) * w + x].sphere = hit.hit ? hit.sphere : -1;
-            info[size_t(y) * w + x].normal = hit.normal;
-        }
-    for (int y = 1; y + 1 < h; ++y)
-        for (int x = 1; x + 1 < w; ++x) {
-            int id = info[size_t(y) * w + x].sphere;
-            bool same = id >= 0;
-            for (int dy = -1; dy <= 1; ++dy)
-                for (int dx = -1; dx <= 1; ++dx) same &= info[size_t(y + dy) * w + x + dx].sphere == id;
-            info[size_t(y) * w + x].interior = same;
-        }
-    return info;
 }
 
 // EnvBRDFApprox (Karis 2014), as env_brdf.glsl, evaluated on the CPU.

@@ -19,21 +19,13 @@
 #include "renderers/mobile/mobile_renderer.h"
 #include "renderers/renderer.h"
 #include "renderers/scenes/scene.h"
+#include "tests/gpu_test_support.h"
 #include "tests/test_support.h"
 
 using namespace iblcheck;
+using namespace iblcheck::testutil;
 
 namespace {
-
-GpuSession& session() {
-    static GpuSession s(vk::ContextOptions{"", true});
-    return s;
-}
-
-void expect_no_validation_errors() {
-    auto& ctx = session().ctx();
-    EXPECT_EQ(ctx.validation_errors(), 0) << (ctx.validation_messages().empty() ? "" : ctx.validation_messages()[0]);
-}
 
 using Opts = std::vector<std::pair<std::string, std::string>>;
 
@@ -56,34 +48,6 @@ std::string describe(const Opts& o) {
     std::string d;
     for (auto& [k, v] : o) d += (d.empty() ? "" : ",") + k + "=" + v;
     return d.empty() ? "default" : d;
-}
-
-// The sphere under each pixel centre, whether its 3x3 neighbourhood is all that sphere, and the
-// normal there (orthographic camera looking −Z: v = +Z).
-struct PixelInfo {
-    int sphere = -1;
-    bool interior = false;
-    Vec3f normal;
-};
-std::vector<PixelInfo> pixel_info(const TestSpec& s, int w, int h) {
-    Scene scene = build_scene(s.scene, s.options);
-    std::vector<PixelInfo> info(size_t(w) * h);
-    for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x) {
-            Vec3f o, d;
-            camera_ray(scene, w, h, x + 0.5, y + 0.5, o, d);
-            Hit hit = intersect(scene, o, d);
-            info[size_t(y) * w + x] = {hit.hit ? hit.sphere : -1, false, hit.normal};
-        }
-    for (int y = 1; y + 1 < h; ++y)
-        for (int x = 1; x + 1 < w; ++x) {
-            int id = info[size_t(y) * w + x].sphere;
-            bool same = id >= 0;
-            for (int dy = -1; dy <= 1; ++dy)
-                for (int dx = -1; dx <= 1; ++dx) same &= info[size_t(y + dy) * w + x + dx].sphere == id;
-            info[size_t(y) * w + x].interior = same;
-        }
-    return info;
 }
 
 // Mean of channel-summed pixels per sphere over interior pixels.
