@@ -4,6 +4,7 @@
 #include <cmath>
 #include <vector>
 
+#include "harness/common/multiversion.h"
 #include "renderers/reference/adaptive_refine.h"
 
 namespace iblcheck::truth {
@@ -48,10 +49,10 @@ double clip_above_horizon(const EnvPyramid::Rect& r, V3 n, V3& centroid) {
 }
 
 // f·cos⁺ (truth_math.h, fcos) at four directions at once: structure-of-arrays and branch-free (the
-// horizon is a max(0, ·) mask), so the compiler vectorises it; GCC's target_clones adds an AVX2+FMA
+// horizon is a max(0, ·) mask), so the compiler vectorises it; GCC's target_clones (IBLCHECK_CLONES_HASWELL) adds an AVX2+FMA
 // version picked at run time on machines that have it (the results differ from the default version's
 // in the last bits; each is deterministic).
-__attribute__((target_clones("arch=haswell", "default"))) void
+IBLCHECK_CLONES_HASWELL void
 fcos4(const MaterialLobe& L, const ShadingPoint& s, const double* lx, const double* ly, const double* lz, double out[3][4]) {
     double nl[4];
     for (int k = 0; k < 4; ++k) nl[k] = std::max(0.0, s.n.x * lx[k] + s.n.y * ly[k] + s.n.z * lz[k]);
