@@ -52,8 +52,8 @@ double clip_above_horizon(const EnvPyramid::Rect& r, V3 n, V3& centroid) {
 // horizon is a max(0, ·) mask), so the compiler vectorises it; GCC's target_clones (IBLCHECK_CLONES_HASWELL) adds an AVX2+FMA
 // version picked at run time on machines that have it (the results differ from the default version's
 // in the last bits; each is deterministic).
-IBLCHECK_CLONES_HASWELL void
-fcos4(const MaterialLobe& L, const ShadingPoint& s, const double* lx, const double* ly, const double* lz, double out[3][4]) {
+IBLCHECK_CLONES_HASWELL void fcos4(const MaterialLobe& L, const ShadingPoint& s, const double* lx, const double* ly,
+                                   const double* lz, double out[3][4]) {
     double nl[4];
     for (int k = 0; k < 4; ++k) nl[k] = std::max(0.0, s.n.x * lx[k] + s.n.y * ly[k] + s.n.z * lz[k]);
     for (int q = 0; q < 3; ++q)
