@@ -1,6 +1,8 @@
 # Build speed (issue 20): a fresh build on 2 cores in under 2 minutes. Nothing here changes what
 # is built, only how fast:
 #   - ccache when installed (optional; IBLCHECK_CCACHE=OFF to skip it),
+#   - one precompiled header for the test programs (tests/CMakeLists.txt, IBLCHECK_TEST_PCH),
+#   - scripts/build.sh builds only the tool; the test programs are built by test.sh (build.sh --all),
 #   - lld, else gold, instead of ld.bfd (a link of iblcheck: 1.8 s CPU with bfd, 1.1 gold, 0.5 lld),
 #   - unity builds: the .cpp files of a target compiled a few at a time as one translation unit,
 #     so nlohmann/json, fmt, CLI11 and OpenCV templates are parsed and compiled once per batch
@@ -14,7 +16,9 @@ set(IBLCHECK_LINKER "auto" CACHE STRING "Linker: auto (lld, else gold, else the 
 if(IBLCHECK_CCACHE)
   find_program(IBLCHECK_CCACHE_PROGRAM ccache)
   if(IBLCHECK_CCACHE_PROGRAM)
-    set(CMAKE_CXX_COMPILER_LAUNCHER "${IBLCHECK_CCACHE_PROGRAM}")
+    # The tests' precompiled header (tests/CMakeLists.txt) is cacheable only with these sloppiness
+    # settings (ccache manual, "Precompiled headers"); without them ccache compiles those uncached.
+    set(CMAKE_CXX_COMPILER_LAUNCHER env CCACHE_SLOPPINESS=pch_defines,time_macros "${IBLCHECK_CCACHE_PROGRAM}")
     message(STATUS "iblcheck: compiling through ${IBLCHECK_CCACHE_PROGRAM}")
   endif()
 endif()
