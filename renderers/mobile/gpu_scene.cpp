@@ -6,9 +6,9 @@
 namespace iblcheck {
 
 namespace {
-Vec3f sub(Vec3f a, Vec3f b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-Vec3f cross(Vec3f a, Vec3f b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
-Vec3f normalize(Vec3f a) {
+// Divides by the length (vec3.h's normalize multiplies by its reciprocal): the camera basis every
+// committed golden was rendered with depends on these last bits.
+Vec3f normalize_by_division(Vec3f a) {
     float l = std::sqrt(a.x * a.x + a.y * a.y + a.z * a.z);
     return {a.x / l, a.y / l, a.z / l};
 }
@@ -42,8 +42,8 @@ vk::Buffer upload_scene(vk::Context& ctx, const Scene& scene) {
     auto* f = buf.as<float>();
     const Camera& c = scene.camera;
     // scene.h: forward = normalize(target − eye), right = normalize(forward × world_up), up = right × forward.
-    Vec3f fwd = normalize(sub(c.target, c.eye));
-    Vec3f right = normalize(cross(fwd, c.world_up));
+    Vec3f fwd = normalize_by_division(c.target - c.eye);
+    Vec3f right = normalize_by_division(cross(fwd, c.world_up));
     Vec3f up = cross(right, fwd);
     put(f + 0, c.eye, c.orthographic ? 1.0f : 0.0f);
     put(f + 4, fwd, c.half_height);

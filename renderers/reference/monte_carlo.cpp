@@ -13,6 +13,7 @@
 
 #include <fmt/format.h>
 
+#include "harness/common/vec3.h"
 #include "renderers/material_model.h"
 
 namespace iblcheck {
@@ -23,15 +24,7 @@ constexpr double kPi = model::kPi;
 constexpr double kMirrorAlpha = 1e-4;
 constexpr double kMinNdotV = 1e-5;
 
-struct V3 {
-    double x, y, z;
-};
-inline V3 operator+(V3 a, V3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-inline V3 operator-(V3 a, V3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-inline V3 operator*(double s, V3 a) { return {s * a.x, s * a.y, s * a.z}; }
-inline double dot(V3 a, V3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-inline V3 cross(V3 a, V3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
-inline V3 normalize(V3 a) { return (1.0 / std::sqrt(dot(a, a))) * a; }
+using V3 = Vec3d; // harness/common/vec3.h, with its operations
 
 enum class Lobes { all, diffuse, specular };
 
@@ -209,7 +202,7 @@ void shade(const Shader& S, const MatConst& M, const EnvWindow& win, V3 n, V3 v,
     u1 = std::min(u1, 1.0 - 1e-16);
     if (pick_spec) {
         // Heitz 2018 VNDF sampling.
-        V3 vh = normalize({alpha * vl.x, alpha * vl.y, vl.z});
+        V3 vh = normalize(V3{alpha * vl.x, alpha * vl.y, vl.z});
         double lensq = vh.x * vh.x + vh.y * vh.y;
         V3 T1 = lensq > 0 ? (1.0 / std::sqrt(lensq)) * V3{-vh.y, vh.x, 0} : V3{1, 0, 0};
         V3 T2 = cross(vh, T1);
@@ -218,7 +211,7 @@ void shade(const Shader& S, const MatConst& M, const EnvWindow& win, V3 n, V3 v,
         double s = 0.5 * (1 + vh.z);
         t2 = (1 - s) * std::sqrt(std::max(0.0, 1 - t1 * t1)) + s * t2;
         V3 nh = t1 * T1 + t2 * T2 + std::sqrt(std::max(0.0, 1 - t1 * t1 - t2 * t2)) * vh;
-        V3 h = normalize({alpha * nh.x, alpha * nh.y, std::max(0.0, nh.z)});
+        V3 h = normalize(V3{alpha * nh.x, alpha * nh.y, std::max(0.0, nh.z)});
         l = 2 * dot(vl, h) * h + (-1.0) * vl;
     } else {
         double r = std::sqrt(u0), phi = 2 * kPi * u1;
@@ -546,7 +539,7 @@ ReferenceRender render_reference_full(const TestSpec& spec, const Environment* e
                 V3 nrm;
                 if (!intersect_candidates(scene, cand, o3, d3, sph, nrm)) continue;
                 ++hits;
-                V3 v = normalize({-d3.x, -d3.y, -d3.z});
+                V3 v = normalize(V3{-d3.x, -d3.y, -d3.z});
                 // This sphere's window, built at its first hit in the pixel.
                 size_t ci = size_t(std::find(cand.begin(), cand.end(), sph) - cand.begin());
                 if (S.window && !win_built[ci]) {

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "harness/common/vec3.h"
 #include "renderers/material_model.h"
 #include "renderers/scenes/scene.h"
 
@@ -11,15 +12,8 @@ namespace iblcheck::truth {
 
 inline constexpr double kPi = model::kPi;
 
-struct V3 {
-    double x = 0, y = 0, z = 0;
-};
-inline V3 operator+(V3 a, V3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-inline V3 operator-(V3 a, V3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-inline V3 operator*(double s, V3 a) { return {s * a.x, s * a.y, s * a.z}; }
-inline double dot(V3 a, V3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-inline V3 normalize(V3 a) { return (1.0 / std::sqrt(dot(a, a))) * a; }
-inline V3 to_v3(Vec3f v) { return {v.x, v.y, v.z}; }
+using V3 = Vec3d; // harness/common/vec3.h, with its operations
+inline V3 to_v3(Vec3f v) { return to_vec3d(v); }
 
 // Mean of the absolute channel values: the scalar size of an RGB error or value.
 inline double rgb_size(const double c[3]) { return (std::fabs(c[0]) + std::fabs(c[1]) + std::fabs(c[2])) / 3; }
