@@ -1,20 +1,41 @@
 // Helpers the GPU pipeline tests share (test_mobile_pipeline, test_mobile_storage_layout,
-// test_fragment_shading): one lavapipe session per test program with validation on, its
-// validation check, and which sphere (and normal) lies under each pixel centre.
+// test_fragment_shading, test_mobile_cost_fp16): a mobile spec and its render, one lavapipe session
+// per test program with validation on, its validation check, and which sphere (and normal) lies under each pixel centre.
 #pragma once
 #include <gtest/gtest.h>
 
+#include <string>
+#include <utility>
 #include <vector>
 
+#include "renderers/environments/environment.h"
 #include "renderers/mobile/mobile_renderer.h"
 #include "renderers/scenes/scene.h"
 
 namespace iblcheck::testutil {
 
+// A mobile-method test spec: scene, environment and option key=value pairs.
+inline TestSpec spec(const std::string& scene, const std::string& env,
+                     const std::vector<std::pair<std::string, std::string>>& opts = {}) {
+    TestSpec s;
+    s.scene = scene;
+    s.env = env;
+    s.method = "mobile";
+    for (auto& [k, v] : opts) s.options.set(k, v);
+    return s;
+}
+
 // One GPU session per test program, with the Vulkan validation layer when it is installed.
 inline GpuSession& session() {
     static GpuSession s(vk::ContextOptions{"", true});
     return s;
+}
+
+// The spec validated, then rendered by the mobile method in that session.
+inline RenderResult render(const TestSpec& s) {
+    validate_spec(s);
+    Environment env = load_environment(s.env);
+    return render_mobile(session(), env, s);
 }
 
 inline void expect_no_validation_errors() {

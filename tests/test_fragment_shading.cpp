@@ -23,21 +23,6 @@ using namespace iblcheck::testutil;
 
 namespace {
 
-TestSpec spec(const std::string& scene, const std::string& env, std::vector<std::pair<std::string, std::string>> opts = {}) {
-    TestSpec s;
-    s.scene = scene;
-    s.env = env;
-    s.method = "mobile";
-    for (auto& [k, v] : opts) s.options.set(k, v);
-    return s;
-}
-
-RenderResult render(const TestSpec& s) {
-    validate_spec(s);
-    Environment env = load_environment(s.env);
-    return render_mobile(session(), env, s);
-}
-
 TestSpec with(TestSpec s, const std::string& key, const std::string& value) {
     s.options.set(key, value);
     return s;

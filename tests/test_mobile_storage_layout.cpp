@@ -29,21 +29,6 @@ namespace {
 
 using Opts = std::vector<std::pair<std::string, std::string>>;
 
-TestSpec spec(const std::string& scene, const std::string& env, const Opts& opts = {}) {
-    TestSpec s;
-    s.scene = scene;
-    s.env = env;
-    s.method = "mobile";
-    for (auto& [k, v] : opts) s.options.set(k, v);
-    return s;
-}
-
-RenderResult render(const TestSpec& s) {
-    validate_spec(s);
-    Environment env = load_environment(s.env);
-    return render_mobile(session(), env, s);
-}
-
 std::string describe(const Opts& o) {
     std::string d;
     for (auto& [k, v] : o) d += (d.empty() ? "" : ",") + k + "=" + v;
