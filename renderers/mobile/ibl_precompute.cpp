@@ -86,25 +86,26 @@ vk::Defines storage_defines(const PrecomputeSettings& s, bool native_r11g11b10) 
     return d;
 }
 
-IblResources run_precompute(GpuSession& gpu, const Environment& env, const PrecomputeSettings& s,
-                            std::vector<PassTiming>& timings) {
-    vk::Context& ctx = gpu.ctx();
-    if (s.cube_size < 8 || s.cube_size > 2048 || (s.cube_size & (s.cube_size - 1)))
-        throw UsageError("option 'cube_size': " + std::to_string(s.cube_size) + " must be a power of two in 8..2048");
-    IblResources r;
-    r.full_mips = uint32_t(std::log2(double(s.cube_size))) + 1;
-    uint32_t mips = std::min(s.mips, r.full_mips);
-    if (mips < 1) throw UsageError("option 'mips' must be at least 1");
-    const EnvLayout layout = env_layout_from_option(s.env_layout);
-    const LayoutExtent extent = layout_extent(layout, s.cube_size);
+namespace {
+
+// The checks that need the layout: a bad option is a usage error before any GPU work.
+void check_layout_settings(const PrecomputeSettings& s, EnvLayout layout, uint32_t mips) {
     if (s.prefiltered) check_layout_mips(layout, s.cube_size, mips);
     if (is_astc(s.storage)) astc_block_from_option(s.astc_block); // a bad block is a usage error before any work
+}
 
-    // Upload the equirect (RGB float → RGBA32F).
-    const cv::Mat& eq = env.equirect;
+// The equirect in a host-visible staging buffer (RGB float → RGBA32F, alpha 1) and the image it is
+// copied into; the copy is recorded with the passes.
+struct EquirectUpload {
+    vk::Buffer staging;
+    vk::Image image;
+};
+
+EquirectUpload stage_equirect(vk::Context& ctx, const cv::Mat& eq) {
     const uint32_t ew = uint32_t(eq.cols), eh = uint32_t(eq.rows);
-    vk::Buffer staging = ctx.create_buffer(VkDeviceSize(ew) * eh * 16, VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
-    float* dst = staging.as<float>();
+    EquirectUpload up;
+    up.staging = ctx.create_buffer(VkDeviceSize(ew) * eh * 16, VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+    float* dst = up.staging.as<float>();
     for (uint32_t y = 0; y < eh; ++y) {
         const float* row = eq.ptr<float>(int(y));
         for (uint32_t x = 0; x < ew; ++x) {
@@ -112,9 +113,15 @@ IblResources run_precompute(GpuSession& gpu, const Environment& env, const Preco
             dst[4 * (size_t(y) * ew + x) + 3] = 1.0f;
         }
     }
-    vk::Image equirect = ctx.create_image(VK_FORMAT_R32G32B32A32_SFLOAT, ew, eh, 1, false);
-    r.source_cube = ctx.create_image(VK_FORMAT_R32G32B32A32_SFLOAT, s.cube_size, s.cube_size, r.full_mips, true);
+    up.image = ctx.create_image(VK_FORMAT_R32G32B32A32_SFLOAT, ew, eh, 1, false);
+    return up;
+}
 
+// The images and buffers the passes write. A pass that is off gets a 1×1 placeholder so the
+// shading pass's descriptor set is the same shape for every variant.
+void allocate_outputs(vk::Context& ctx, const PrecomputeSettings& s, EnvLayout layout, const LayoutExtent& extent, uint32_t mips,
+                      IblResources& r) {
+    r.source_cube = ctx.create_image(VK_FORMAT_R32G32B32A32_SFLOAT, s.cube_size, s.cube_size, r.full_mips, true);
     r.native_r11g11b10 = s.storage == "r11g11b10" && ctx.format_supports(VK_FORMAT_B10G11R11_UFLOAT_PACK32,
                                                                          VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT |
                                                                              VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT);
@@ -136,6 +143,149 @@ IblResources run_precompute(GpuSession& gpu, const Environment& env, const Preco
     r.irradiance = s.irradiance_cube
                        ? ctx.create_image(VK_FORMAT_R32G32B32A32_SFLOAT, s.irradiance_size, s.irradiance_size, 1, true)
                        : ctx.create_image(VK_FORMAT_R32G32B32A32_SFLOAT, 1, 1, 1, true);
+}
+
+// What every pass records into: one command buffer, timed per pass. Each pass warms its pipeline
+// up outside the timed span (the first dispatch of a pipeline pays lavapipe's JIT).
+struct Recording {
+    GpuSession& gpu;
+    vk::Context& ctx;
+    VkCommandBuffer cmd;
+    vk::GpuTimer& timer;
+    const PrecomputeSettings& s;
+    IblResources& r;
+};
+
+void record_upload(const Recording& rec, const EquirectUpload& up) {
+    vk::Context& ctx = rec.ctx;
+    IblResources& r = rec.r;
+    ctx.transition(rec.cmd, up.image, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
+    ctx.copy_buffer_to_image(rec.cmd, up.staging, up.image);
+    ctx.transition(rec.cmd, up.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL);
+    for (vk::Image* img : {&r.source_cube, &r.prefiltered, &r.lut, &r.irradiance})
+        ctx.transition(rec.cmd, *img, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL);
+}
+
+// Equirect → cube mip 0, supersampled so each cube texel averages the equirect pixels it covers.
+void record_equirect_to_cube(const Recording& rec, const vk::ComputePipeline& p, const vk::Image& equirect) {
+    const PrecomputeSettings& s = rec.s;
+    EquirectToCubePush pe{s.cube_size, std::max(1u, (equirect.width + 4 * s.cube_size - 1) / (4 * s.cube_size)),
+                          s.env_rotation_deg};
+    std::vector<vk::Binding> be = {vk::Binding::sampled_image(0, equirect.sampled_view, rec.ctx.equirect_sampler()),
+                                   vk::Binding::storage_image(1, rec.r.source_cube.storage_views[0])};
+    p.warm_up(rec.cmd, be, &pe, sizeof pe);
+    rec.timer.begin(rec.cmd, "equirect_to_cube");
+    p.dispatch(rec.cmd, be, &pe, sizeof pe, groups(s.cube_size), groups(s.cube_size), 6);
+    rec.timer.end(rec.cmd);
+    rec.ctx.barrier(rec.cmd);
+}
+
+// The source cube's full mip chain, each level a box filter of the one above.
+void record_downsample(const Recording& rec, const vk::ComputePipeline& p) {
+    const PrecomputeSettings& s = rec.s;
+    const IblResources& r = rec.r;
+    if (r.full_mips > 1) {
+        const DownsamplePush size1{std::max(1u, s.cube_size >> 1)};
+        p.warm_up(rec.cmd,
+                  {vk::Binding::storage_image(0, r.source_cube.storage_views[0]),
+                   vk::Binding::storage_image(1, r.source_cube.storage_views[1])},
+                  &size1, sizeof size1);
+    }
+    rec.timer.begin(rec.cmd, "downsample_cube");
+    for (uint32_t m = 1; m < r.full_mips; ++m) {
+        const DownsamplePush size{std::max(1u, s.cube_size >> m)};
+        p.dispatch(rec.cmd,
+                   {vk::Binding::storage_image(0, r.source_cube.storage_views[m - 1]),
+                    vk::Binding::storage_image(1, r.source_cube.storage_views[m])},
+                   &size, sizeof size, groups(size.dst_size), groups(size.dst_size), 6);
+        rec.ctx.barrier(rec.cmd);
+    }
+    rec.timer.end(rec.cmd);
+}
+
+// GGX-prefiltered specular levels, one roughness per mip, in the storage format and layout asked for.
+void record_prefilter(const Recording& rec, const vk::ComputePipeline& p, const LayoutExtent& extent, uint32_t mips) {
+    const PrecomputeSettings& s = rec.s;
+    const IblResources& r = rec.r;
+    vk::Context& ctx = rec.ctx;
+    for (uint32_t m = 0; m < mips; ++m) {
+        if (m == 0) { // warm-up: a mip-0 copy of one workgroup, overwritten below
+            PrefilterPush pw{
+                0, s.cube_size, s.cube_size, s.prefilter_samples, float(r.full_mips), float(mips - 1), float(r.full_mips - 1)};
+            p.warm_up(rec.cmd,
+                      {vk::Binding::sampled_image(0, r.source_cube.sampled_view, ctx.linear_sampler()),
+                       vk::Binding::storage_image(1, r.prefiltered.storage_views[0])},
+                      &pw, sizeof pw);
+            rec.timer.begin(rec.cmd, "prefilter_ggx");
+        }
+        // dst_size: the cube's face size, or a 2D layout level's width (its height follows).
+        const uint32_t w = std::max(1u, extent.width >> m), h = std::max(1u, extent.height >> m);
+        PrefilterPush pp{m, w, s.cube_size, s.prefilter_samples, float(r.full_mips), float(mips - 1), float(r.full_mips - 1)};
+        p.dispatch(rec.cmd,
+                   {vk::Binding::sampled_image(0, r.source_cube.sampled_view, ctx.linear_sampler()),
+                    vk::Binding::storage_image(1, r.prefiltered.storage_views[m])},
+                   &pp, sizeof pp, groups(w), groups(h), extent.layers);
+    }
+    rec.timer.end(rec.cmd);
+    ctx.barrier(rec.cmd);
+}
+
+// SH9 from a 32² level (or the base if smaller): enough for 9 coefficients, and exact weights.
+void record_sh9(const Recording& rec, const vk::ComputePipeline& p) {
+    const PrecomputeSettings& s = rec.s;
+    uint32_t sh_mip = s.cube_size > 32 ? uint32_t(std::log2(double(s.cube_size / 32))) : 0;
+    const Sh9Push sh_size{s.cube_size >> sh_mip};
+    std::vector<vk::Binding> bsh = {vk::Binding::storage_image(0, rec.r.source_cube.storage_views[sh_mip]),
+                                    vk::Binding::storage_buffer(1, rec.r.sh)};
+    p.warm_up(rec.cmd, bsh, &sh_size, sizeof sh_size);
+    rec.timer.begin(rec.cmd, "sh9_project");
+    p.dispatch(rec.cmd, bsh, &sh_size, sizeof sh_size, 1);
+    rec.timer.end(rec.cmd);
+}
+
+// The split-sum's DFG table (env_brdf=lut); its pipeline is only built when the variant uses it.
+void record_dfg_lut(const Recording& rec) {
+    const PrecomputeSettings& s = rec.s;
+    const auto& p_lut = rec.gpu.pipeline("dfg_lut.comp", {}, {kStorageImage}, sizeof(DfgLutPush));
+    const DfgLutPush pl{s.lut_size, s.lut_samples};
+    p_lut.warm_up(rec.cmd, {vk::Binding::storage_image(0, rec.r.lut.storage_views[0])}, &pl, sizeof pl);
+    rec.timer.begin(rec.cmd, "dfg_lut");
+    p_lut.dispatch(rec.cmd, {vk::Binding::storage_image(0, rec.r.lut.storage_views[0])}, &pl, sizeof pl, groups(s.lut_size),
+                   groups(s.lut_size), 1);
+    rec.timer.end(rec.cmd);
+}
+
+// The diffuse irradiance cube (diffuse=irradiance_cube), convolved from a 16² level.
+void record_irradiance(const Recording& rec) {
+    const PrecomputeSettings& s = rec.s;
+    const auto& p_irr = rec.gpu.pipeline("irradiance_cube.comp", {}, {kStorageImage, kStorageImage}, sizeof(IrradiancePush));
+    uint32_t src_mip = s.cube_size > 16 ? uint32_t(std::log2(double(s.cube_size / 16))) : 0;
+    const IrradiancePush pi{s.irradiance_size, s.cube_size >> src_mip};
+    std::vector<vk::Binding> bi = {vk::Binding::storage_image(0, rec.r.source_cube.storage_views[src_mip]),
+                                   vk::Binding::storage_image(1, rec.r.irradiance.storage_views[0])};
+    p_irr.warm_up(rec.cmd, bi, &pi, sizeof pi);
+    rec.timer.begin(rec.cmd, "irradiance_cube");
+    p_irr.dispatch(rec.cmd, bi, &pi, sizeof pi, groups(s.irradiance_size), groups(s.irradiance_size), 6);
+    rec.timer.end(rec.cmd);
+}
+
+} // namespace
+
+IblResources run_precompute(GpuSession& gpu, const Environment& env, const PrecomputeSettings& s,
+                            std::vector<PassTiming>& timings) {
+    vk::Context& ctx = gpu.ctx();
+    if (s.cube_size < 8 || s.cube_size > 2048 || (s.cube_size & (s.cube_size - 1)))
+        throw UsageError("option 'cube_size': " + std::to_string(s.cube_size) + " must be a power of two in 8..2048");
+    IblResources r;
+    r.full_mips = uint32_t(std::log2(double(s.cube_size))) + 1;
+    const uint32_t mips = std::min(s.mips, r.full_mips);
+    if (mips < 1) throw UsageError("option 'mips' must be at least 1");
+    const EnvLayout layout = env_layout_from_option(s.env_layout);
+    const LayoutExtent extent = layout_extent(layout, s.cube_size);
+    check_layout_settings(s, layout, mips);
+
+    const EquirectUpload equirect = stage_equirect(ctx, env.equirect);
+    allocate_outputs(ctx, s, layout, extent, mips, r);
 
     const auto& p_e2c = gpu.pipeline("equirect_to_cube.comp", {}, {kSampled, kStorageImage}, sizeof(EquirectToCubePush));
     const auto& p_down = gpu.pipeline("downsample_cube.comp", {}, {kStorageImage, kStorageImage}, sizeof(DownsamplePush));
@@ -145,103 +295,19 @@ IblResources run_precompute(GpuSession& gpu, const Environment& env, const Preco
 
     vk::GpuTimer timer(ctx, 8);
     ctx.submit([&](VkCommandBuffer cmd) {
+        const Recording rec{gpu, ctx, cmd, timer, s, r};
         timer.reset(cmd);
-        ctx.transition(cmd, equirect, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
-        ctx.copy_buffer_to_image(cmd, staging, equirect);
-        ctx.transition(cmd, equirect, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL);
-        for (vk::Image* img : {&r.source_cube, &r.prefiltered, &r.lut, &r.irradiance})
-            ctx.transition(cmd, *img, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL);
-
-        // 1. equirect → cube, supersampled so each cube texel averages the equirect pixels it covers.
-        EquirectToCubePush pe{s.cube_size, std::max(1u, (ew + 4 * s.cube_size - 1) / (4 * s.cube_size)), s.env_rotation_deg};
-        std::vector<vk::Binding> be = {vk::Binding::sampled_image(0, equirect.sampled_view, ctx.equirect_sampler()),
-                                       vk::Binding::storage_image(1, r.source_cube.storage_views[0])};
-        p_e2c.warm_up(cmd, be, &pe, sizeof pe);
-        timer.begin(cmd, "equirect_to_cube");
-        p_e2c.dispatch(cmd, be, &pe, sizeof pe, groups(s.cube_size), groups(s.cube_size), 6);
-        timer.end(cmd);
-        ctx.barrier(cmd);
-
-        if (r.full_mips > 1) {
-            const DownsamplePush size1{std::max(1u, s.cube_size >> 1)};
-            p_down.warm_up(cmd,
-                           {vk::Binding::storage_image(0, r.source_cube.storage_views[0]),
-                            vk::Binding::storage_image(1, r.source_cube.storage_views[1])},
-                           &size1, sizeof size1);
-        }
-        timer.begin(cmd, "downsample_cube");
-        for (uint32_t m = 1; m < r.full_mips; ++m) {
-            const DownsamplePush size{std::max(1u, s.cube_size >> m)};
-            p_down.dispatch(cmd,
-                            {vk::Binding::storage_image(0, r.source_cube.storage_views[m - 1]),
-                             vk::Binding::storage_image(1, r.source_cube.storage_views[m])},
-                            &size, sizeof size, groups(size.dst_size), groups(size.dst_size), 6);
-            ctx.barrier(cmd);
-        }
-        timer.end(cmd);
-
-        if (s.prefiltered) {
-            for (uint32_t m = 0; m < mips; ++m) {
-                if (m == 0) { // warm-up: a mip-0 copy of one workgroup, overwritten below
-                    PrefilterPush pw{0,
-                                     s.cube_size,
-                                     s.cube_size,
-                                     s.prefilter_samples,
-                                     float(r.full_mips),
-                                     float(mips - 1),
-                                     float(r.full_mips - 1)};
-                    p_pre.warm_up(cmd,
-                                  {vk::Binding::sampled_image(0, r.source_cube.sampled_view, ctx.linear_sampler()),
-                                   vk::Binding::storage_image(1, r.prefiltered.storage_views[0])},
-                                  &pw, sizeof pw);
-                    timer.begin(cmd, "prefilter_ggx");
-                }
-                // dst_size: the cube's face size, or a 2D layout level's width (its height follows).
-                const uint32_t w = std::max(1u, extent.width >> m), h = std::max(1u, extent.height >> m);
-                PrefilterPush pp{
-                    m, w, s.cube_size, s.prefilter_samples, float(r.full_mips), float(mips - 1), float(r.full_mips - 1)};
-                p_pre.dispatch(cmd,
-                               {vk::Binding::sampled_image(0, r.source_cube.sampled_view, ctx.linear_sampler()),
-                                vk::Binding::storage_image(1, r.prefiltered.storage_views[m])},
-                               &pp, sizeof pp, groups(w), groups(h), extent.layers);
-            }
-            timer.end(cmd);
-            ctx.barrier(cmd);
-        }
-
-        // SH9 from a 32² level (or the base if smaller): enough for 9 coefficients, and exact weights.
-        uint32_t sh_mip = s.cube_size > 32 ? uint32_t(std::log2(double(s.cube_size / 32))) : 0;
-        const Sh9Push sh_size{s.cube_size >> sh_mip};
-        std::vector<vk::Binding> bsh = {vk::Binding::storage_image(0, r.source_cube.storage_views[sh_mip]),
-                                        vk::Binding::storage_buffer(1, r.sh)};
-        p_sh.warm_up(cmd, bsh, &sh_size, sizeof sh_size);
-        timer.begin(cmd, "sh9_project");
-        p_sh.dispatch(cmd, bsh, &sh_size, sizeof sh_size, 1);
-        timer.end(cmd);
-
-        if (s.lut) {
-            const auto& p_lut = gpu.pipeline("dfg_lut.comp", {}, {kStorageImage}, sizeof(DfgLutPush));
-            const DfgLutPush pl{s.lut_size, s.lut_samples};
-            p_lut.warm_up(cmd, {vk::Binding::storage_image(0, r.lut.storage_views[0])}, &pl, sizeof pl);
-            timer.begin(cmd, "dfg_lut");
-            p_lut.dispatch(cmd, {vk::Binding::storage_image(0, r.lut.storage_views[0])}, &pl, sizeof pl, groups(s.lut_size),
-                           groups(s.lut_size), 1);
-            timer.end(cmd);
-        }
-        if (s.irradiance_cube) {
-            const auto& p_irr = gpu.pipeline("irradiance_cube.comp", {}, {kStorageImage, kStorageImage}, sizeof(IrradiancePush));
-            uint32_t src_mip = s.cube_size > 16 ? uint32_t(std::log2(double(s.cube_size / 16))) : 0;
-            const IrradiancePush pi{s.irradiance_size, s.cube_size >> src_mip};
-            std::vector<vk::Binding> bi = {vk::Binding::storage_image(0, r.source_cube.storage_views[src_mip]),
-                                           vk::Binding::storage_image(1, r.irradiance.storage_views[0])};
-            p_irr.warm_up(cmd, bi, &pi, sizeof pi);
-            timer.begin(cmd, "irradiance_cube");
-            p_irr.dispatch(cmd, bi, &pi, sizeof pi, groups(s.irradiance_size), groups(s.irradiance_size), 6);
-            timer.end(cmd);
-        }
+        record_upload(rec, equirect);
+        record_equirect_to_cube(rec, p_e2c, equirect.image);
+        record_downsample(rec, p_down);
+        if (s.prefiltered) record_prefilter(rec, p_pre, extent, mips);
+        record_sh9(rec, p_sh);
+        if (s.lut) record_dfg_lut(rec);
+        if (s.irradiance_cube) record_irradiance(rec);
         ctx.barrier(cmd);
     });
     for (auto& [name, ms] : timer.results()) timings.push_back({name, ms, true, true});
+    // ASTC is encoded on the host, so its round trip follows the GPU passes.
     if (s.prefiltered && is_astc(s.storage)) r.prefiltered = astc_round_trip(ctx, r.prefiltered, s, timings);
     return r;
 }
