@@ -16,6 +16,7 @@
 #include "metrics/psnr.h"
 #include "metrics/ssim.h"
 #include "metrics/temporal.h"
+#include "tests/test_support.h"
 
 namespace fs = std::filesystem;
 using namespace iblcheck;
@@ -165,9 +166,7 @@ TEST(Temporal, HandComputed) {
 class ImageIo : public ::testing::Test {
   protected:
     void SetUp() override {
-        dir_ = fs::temp_directory_path() / ("iblcheck_io_" + std::to_string(::getpid()) + "_" +
-                                            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-        fs::create_directories(dir_);
+        dir_ = testutil::temp_dir(std::string("io_") + ::testing::UnitTest::GetInstance()->current_test_info()->name());
     }
     void TearDown() override { fs::remove_all(dir_); }
     std::string path(const std::string& n) const { return (dir_ / n).string(); }

@@ -227,6 +227,7 @@ TEST(MobileCost, ShadingTwiceDoublesTheCountAndARunawayLoopMultipliesIt) {
                                     << base_small.shader_instructions_per_pixel;
     fs::remove_all(dir);
 }
+
 TEST(MobileFp16, EmulatedMatchesNativeWithinTheMeasuredBound) {
     if (!session().ctx().info().shader_float16) GTEST_SKIP() << "the native side needs shaderFloat16";
     for (const char* env : {"sky_sun", "studio"}) {

@@ -11,13 +11,13 @@ namespace iblcheck::truth {
 SphereView::SphereView(const Scene& scene, int index, int W, int H, Lobes lobes) : sphere_(scene.spheres[size_t(index)]) {
     const Camera& c = scene.camera;
     // The camera basis of scene.h (camera_ray): forward, right = forward × world_up, up = right × forward.
-    const V3 f = normalize(to_v3(c.target) - to_v3(c.eye)), wu = to_v3(c.world_up);
+    const V3 f = normalize(to_vec3d(c.target) - to_vec3d(c.eye)), wu = to_vec3d(c.world_up);
     right_ = normalize(V3{f.y * wu.z - f.z * wu.y, f.z * wu.x - f.x * wu.z, f.x * wu.y - f.y * wu.x});
     up_ = V3{right_.y * f.z - right_.z * f.y, right_.z * f.x - right_.x * f.z, right_.x * f.y - right_.y * f.x};
     back_ = -1.0 * f;
     const double hh = c.half_height, hw = hh * double(W) / H;
     wpp_ = 2 * hh / H;
-    const V3 rel = to_v3(sphere_.center) - to_v3(c.eye);
+    const V3 rel = to_vec3d(sphere_.center) - to_vec3d(c.eye);
     disc_.cx = (dot(rel, right_) / hw + 1) * W / 2;
     disc_.cy = (1 - dot(rel, up_) / hh) * H / 2;
     disc_.r = sphere_.radius / wpp_;

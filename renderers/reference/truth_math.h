@@ -13,7 +13,6 @@ namespace iblcheck::truth {
 inline constexpr double kPi = model::kPi;
 
 using V3 = Vec3d; // harness/common/vec3.h, with its operations
-inline V3 to_v3(Vec3f v) { return to_vec3d(v); }
 
 // Mean of the absolute channel values: the scalar size of an RGB error or value.
 inline double rgb_size(const double c[3]) { return (std::fabs(c[0]) + std::fabs(c[1]) + std::fabs(c[2])) / 3; }
