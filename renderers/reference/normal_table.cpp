@@ -2,16 +2,60 @@
 #include "renderers/reference/normal_table.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
+#include <cstdint>
 #include <mutex>
 #include <thread>
+#include <unordered_map>
 
 namespace iblcheck::truth {
 
 namespace {
 constexpr double kBrightRatio = 4; // forced: the cone holds radiance > 4x what the cell's values see
 } // namespace
+
+// (Not in the anonymous namespace: NormalTable::Builder, declared in the header, holds a pointer to it.)
+namespace table_detail {
+// The shading at edge midpoints, shared by the two cells of equal size on either side of the edge (in
+// the same coarse cell or across coarse cells, whichever thread builds them): each such node is shaded
+// once instead of twice. Keyed by the node's position on the finest lattice and the cell size it was
+// shaded for (a node's quadrature tolerance depends on that size), so a shared value is exactly the
+// value either cell would have computed: the table is the same, bit for bit, with or without sharing.
+// Sharded by key, one mutex per shard. Two threads may race to shade the same node; both compute the
+// same value and only the first to store it counts its work, so the counts are deterministic too.
+class SharedNodes {
+  public:
+    struct Value {
+        std::array<float, 3> rgb;
+    };
+    bool find(uint64_t key, float out[3]) {
+        Shard& sh = shard(key);
+        std::lock_guard<std::mutex> lock(sh.m);
+        const auto it = sh.map.find(key);
+        if (it == sh.map.end()) return false;
+        for (int q = 0; q < 3; ++q) out[q] = it->second.rgb[size_t(q)];
+        return true;
+    }
+    // False if another thread stored the key first (the caller's work is then not counted).
+    bool store(uint64_t key, const float v[3]) {
+        Shard& sh = shard(key);
+        std::lock_guard<std::mutex> lock(sh.m);
+        return sh.map.emplace(key, Value{{v[0], v[1], v[2]}}).second;
+    }
+
+  private:
+    struct Shard {
+        std::mutex m;
+        std::unordered_map<uint64_t, Value> map;
+    };
+    static constexpr size_t kShards = 64;
+    Shard& shard(uint64_t key) { return shards_[(key * 0x9E3779B97F4A7C15ull) >> 58]; }
+    std::array<Shard, kShards> shards_;
+};
+} // namespace table_detail
+using table_detail::SharedNodes;
 
 void NormalTable::to_map(V3 n, double& X, double& Y) const {
     const double c = std::max(-1 + 1e-12, dot(n, v_)), k = std::sqrt(2 / (1 + c));
@@ -31,7 +75,24 @@ struct NormalTable::Builder {
     const TableParams& tp;
     const QuadratureParams& qp;
     double floor_ = 0;
-    long nodes = 0, evals = 0;
+    SharedNodes* shared = nullptr;
+    long nodes = 0, evals = 0, reused = 0;
+
+    // An edge midpoint of a cell of size 2h: shaded once for both cells that share the edge.
+    void shared_value(double X, double Y, float out[3], double h) {
+        // Positions are dyadic multiples of the finest half-cell, coarse / 2^(max_depth + 1): exact integers.
+        const double unit = std::ldexp(t.coarse_, -(tp.max_depth + 1));
+        const auto ix = uint64_t(std::llround((X - t.x0_) / unit)), iy = uint64_t(std::llround((Y - t.x0_) / unit));
+        const auto level = uint64_t(std::llround(std::log2(t.coarse_ / h)));
+        const uint64_t key = (ix << 36) | (iy << 8) | level;
+        if (shared->find(key, out)) {
+            ++reused;
+            return;
+        }
+        const long n0 = nodes, e0 = evals;
+        value(X, Y, out, h);
+        if (!shared->store(key, out)) nodes = n0, evals = e0, ++reused; // another thread shaded it first
+    }
 
     // The shading at (X, Y), a node of cells of size s (0: the coarse grid).
     void value(double X, double Y, float out[3], double s = 0) {
@@ -79,8 +140,8 @@ struct NormalTable::Builder {
         float g[9][3];
         for (int q = 0; q < 3; ++q) g[0][q] = c00[q], g[2][q] = c10[q], g[6][q] = c01[q], g[8][q] = c11[q];
         const double h = s / 2;
-        value(x0 + h, y0, g[1], h), value(x0, y0 + h, g[3], h), value(x0 + h, y0 + h, g[4], h);
-        value(x0 + s, y0 + h, g[5], h), value(x0 + h, y0 + s, g[7], h);
+        shared_value(x0 + h, y0, g[1], h), shared_value(x0, y0 + h, g[3], h), value(x0 + h, y0 + h, g[4], h);
+        shared_value(x0 + s, y0 + h, g[5], h), shared_value(x0 + h, y0 + s, g[7], h);
         // Cells wider than a pixel's footprint (in normal space) must interpolate well pointwise: the
         // largest difference between a test value and the bilinear prediction. Smaller cells only enter
         // pixels through their integral: the difference between the cell's trapezoid (corners) and
@@ -159,7 +220,7 @@ NormalTable::NormalTable(const EnvPyramid& env, const MaterialLobe& lobe, V3 v, 
     // Coarse grid nodes first (shared by the cells), then the cells; both in parallel, deterministic.
     std::vector<float> grid(size_t(n_ + 1) * (n_ + 1) * 3, 0.0f);
     std::atomic<int> next{0}, done{0};
-    std::atomic<long> nodes{0}, evals{0};
+    std::atomic<long> nodes{0}, evals{0}, reused{0};
     std::mutex m;
     auto run = [&](auto&& body) {
         next = 0;
@@ -180,8 +241,9 @@ NormalTable::NormalTable(const EnvPyramid& env, const MaterialLobe& lobe, V3 v, 
             }
         nodes += b.nodes, evals += b.evals;
     });
+    SharedNodes shared;
     run([&] {
-        Builder b{*this, env, lobe, tp, qp, tp.floor};
+        Builder b{*this, env, lobe, tp, qp, tp.floor, &shared};
         for (int k; (k = next.fetch_add(1)) < n_ * n_;) {
             const int i = k % n_, j = k / n_;
             if (needed(i, j)) {
@@ -197,9 +259,9 @@ NormalTable::NormalTable(const EnvPyramid& env, const MaterialLobe& lobe, V3 v, 
                 progress(double(d) / (double(n_) * n_));
             }
         }
-        nodes += b.nodes, evals += b.evals;
+        nodes += b.nodes, evals += b.evals, reused += b.reused;
     });
-    nodes_ = nodes, evals_ = evals;
+    nodes_ = nodes, evals_ = evals, shared_ = reused;
 }
 
 long NormalTable::leaves() const {

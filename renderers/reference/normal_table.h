@@ -46,6 +46,9 @@ class NormalTable {
     double variation(V3 n, double radius) const;
     long nodes() const { return nodes_; }       // shading points evaluated
     long evaluations() const { return evals_; } // BRDF evaluations in them
+    // Edge midpoints a cell took from its neighbour instead of shading them again (normal_table.cpp,
+    // SharedNodes); deterministic, like nodes().
+    long shared_nodes() const { return shared_; }
     long leaves() const;
     // The map and its inverse (exposed for tests).
     void to_map(V3 n, double& X, double& Y) const;
@@ -65,7 +68,7 @@ class NormalTable {
     double x0_ = 0, coarse_ = 0;
     int n_ = 0;                            // coarse cells per side
     std::vector<std::vector<Cell>> trees_; // per coarse cell (row-major), root at index 0
-    long nodes_ = 0, evals_ = 0;
+    long nodes_ = 0, evals_ = 0, shared_ = 0;
 };
 
 } // namespace iblcheck::truth

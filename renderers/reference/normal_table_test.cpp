@@ -99,3 +99,31 @@ TEST(NormalTable, VariationBoundsLookupsInTheCone) {
         EXPECT_LE(rgb_size(d), 1.1 * bound + 1e-9) << k;
     }
 }
+
+// A cell's edge midpoint is shaded once for both cells on the edge (normal_table.cpp, SharedNodes): on a
+// refined table many nodes are taken from a neighbour, and the table — its counts and every lookup — is
+// the same whatever the number of building threads (two threads may race for a node; only one counts).
+TEST(NormalTable, EdgeNodesAreShadedOnceWhateverTheThreads) {
+    EnvPyramid env(load_environment("studio"));
+    const MaterialLobe L = lobe_of(0.3, 1);
+    QuadratureParams qp;
+    qp.tolerance = 1e-3, qp.floor = 1e-3 * env.mean_radiance();
+    TableParams tp;
+    tp.tolerance = 2e-2, tp.floor = qp.floor, tp.footprint = 0.05, tp.max_depth = 4;
+    const NormalTable one(env, L, V3{0, 0, 1}, V3{1, 0, 0}, V3{0, 1, 0}, tp, qp, 1);
+    const NormalTable two(env, L, V3{0, 0, 1}, V3{1, 0, 0}, V3{0, 1, 0}, tp, qp, 2);
+    // Each split cell shades 5 new points (4 edge midpoints and its centre) without sharing; with it, an
+    // interior edge's midpoint is shaded by one of its two cells.
+    EXPECT_GT(one.shared_nodes(), one.nodes() / 4) << one.nodes() << " nodes";
+    EXPECT_EQ(one.nodes(), two.nodes());
+    EXPECT_EQ(one.shared_nodes(), two.shared_nodes());
+    EXPECT_EQ(one.evaluations(), two.evaluations());
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> q(-1, 1);
+    for (int k = 0; k < 200; ++k) {
+        const V3 n = normalize(V3{q(rng), q(rng), std::fabs(q(rng)) + 0.1});
+        double a[3], b[3];
+        one.lookup(n, a), two.lookup(n, b);
+        for (int c = 0; c < 3; ++c) EXPECT_EQ(a[c], b[c]);
+    }
+}
