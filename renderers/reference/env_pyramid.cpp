@@ -15,6 +15,31 @@ V3 env_dir(double phi, double z) {
 }
 double phi_of(double u) { return (u - 0.5) * 2 * kPi; }
 
+// Per channel, the weight offsets (EnvCell::wa) that give the rule channel q's first moment: with weights
+// 1/4 ± a on the pair (p0, p1) and 1/4 ± b on (p2, p3), the rule's mean moves by a(p0 − p1) + b(p2 − p3)
+// from the luminance's; that shift is set to the tangent part of m_q − m_Y (least squares on c's tangent
+// plane, one pair alone when the second has collapsed), then scaled down so that no weight is negative.
+void set_channel_weights(EnvCell& cell, const V3 pts[4], V3 e1, V3 e2) {
+    for (auto& w : cell.wa) w[0] = w[1] = 0;
+    if (cell.np != 4) return;
+    const V3 c{cell.c[0], cell.c[1], cell.c[2]}, mY = double(cell.mlen) * c;
+    const V3 d1 = pts[0] - pts[1], d2 = pts[2] - pts[3];
+    const double a11 = dot(d1, e1), a21 = dot(d1, e2), a12 = dot(d2, e1), a22 = dot(d2, e2);
+    const double det = a11 * a22 - a12 * a21, n1 = a11 * a11 + a21 * a21;
+    for (int q = 0; q < 3; ++q) {
+        const V3 shift = V3{cell.m[q][0], cell.m[q][1], cell.m[q][2]} - mY;
+        const double r1 = dot(shift, e1), r2 = dot(shift, e2);
+        double a = 0, b = 0;
+        if (std::fabs(det) > 1e-9 * (n1 + a12 * a12 + a22 * a22))
+            a = (r1 * a22 - r2 * a12) / det, b = (a11 * r2 - a21 * r1) / det;
+        else if (n1 > 0)
+            a = (r1 * a11 + r2 * a21) / n1;
+        const double big = std::max(std::fabs(a), std::fabs(b));
+        if (big > 0.25) a *= 0.25 / big, b *= 0.25 / big;
+        cell.wa[q][0] = float(a), cell.wa[q][1] = float(b);
+    }
+}
+
 // The cell's rule points: c ± √2·l_k, l_k the columns of the Cholesky factor of its second moment
 // projected on c's tangent plane (they match the luminance-weighted mean and second moment).
 void set_sigma_points(EnvCell& cell) {
@@ -37,6 +62,7 @@ void set_sigma_points(EnvCell& cell) {
         cell.np = 4;
     }
     for (int k = 0; k < 4; ++k) cell.sp[k][0] = float(pts[k].x), cell.sp[k][1] = float(pts[k].y), cell.sp[k][2] = float(pts[k].z);
+    set_channel_weights(cell, pts, e1, e2);
 }
 } // namespace
 
@@ -128,6 +154,7 @@ void EnvPyramid::build_level0(const cv::Mat&) {
 void EnvPyramid::set_texel_moments(EnvCell& c, int i, int j) const {
     const double g = 0.5 / std::sqrt(3.0), du = 0.5 / W_, dth = 0.5 * kPi / H_;
     double w_sum = 0, mu_e[3] = {0, 0, 0}, S[3][3] = {}, wu_sum = 0, mu_u[3] = {0, 0, 0}, Su[3][3] = {};
+    double wq[3] = {0, 0, 0}, mq[3][3] = {}; // per channel: ∫L_q dΩ and ∫L_q ω dΩ
     for (int qa = 0; qa < 2; ++qa)
         for (int qb = 0; qb < 2; ++qb)
             for (int k = 0; k < 4; ++k) {
@@ -139,6 +166,10 @@ void EnvPyramid::set_texel_moments(EnvCell& c, int i, int j) const {
                 const double area = std::sin(th), w = area * (L[0] + L[1] + L[2]);
                 const double v[3] = {d.x, d.y, d.z};
                 w_sum += w, wu_sum += area;
+                for (int q = 0; q < 3; ++q) {
+                    wq[q] += area * L[q];
+                    for (int a = 0; a < 3; ++a) mq[q][a] += area * L[q] * v[a];
+                }
                 for (int a = 0; a < 3; ++a) {
                     mu_e[a] += w * v[a], mu_u[a] += area * v[a];
                     for (int b = 0; b < 3; ++b) S[a][b] += w * v[a] * v[b], Su[a][b] += area * v[a] * v[b];
@@ -173,6 +204,10 @@ void EnvPyramid::set_texel_moments(EnvCell& c, int i, int j) const {
     }
     c.c[0] = float(cc.x), c.c[1] = float(cc.y), c.c[2] = float(cc.z);
     c.mlen = float(ml);
+    for (int q = 0; q < 3; ++q) { // a black channel takes the luminance's mean
+        const V3 m = wq[q] > 0 ? to_world(V3{mq[q][0] / wq[q], mq[q][1] / wq[q], mq[q][2] / wq[q]}) : mu;
+        c.m[q][0] = float(m.x), c.m[q][1] = float(m.y), c.m[q][2] = float(m.z);
+    }
 }
 
 // Second moment of a uniform distribution over a cell's tangent rectangle: (hx²/3)·ex exᵀ + (hy²/3)·ey eyᵀ.
@@ -193,7 +228,7 @@ void EnvPyramid::build_level(int k) {
         for (int i = 0; i < w; ++i) {
             EnvCell& c = out[size_t(j) * w + i];
             double L[3] = {0, 0, 0}, cen[3] = {0, 0, 0}, wsum = 0, lo[3] = {1e300, 1e300, 1e300},
-                   hi[3] = {-1e300, -1e300, -1e300};
+                   hi[3] = {-1e300, -1e300, -1e300}, mq[3][3] = {};
             for (int b = 0; b < 2; ++b)
                 for (int a = 0; a < 2; ++a) {
                     const int ii = 2 * i + a, jj = 2 * j + b;
@@ -203,6 +238,7 @@ void EnvPyramid::build_level(int k) {
                     wsum += wgt;
                     for (int q = 0; q < 3; ++q) {
                         L[q] += s.L[q];
+                        for (int a = 0; a < 3; ++a) mq[q][a] += double(s.L[q]) * s.m[q][a];
                         cen[q] += wgt * s.mlen * s.c[q];
                         lo[q] = std::min(lo[q], double(s.lo[q]));
                         hi[q] = std::max(hi[q], double(s.hi[q]));
@@ -248,6 +284,8 @@ void EnvPyramid::build_level(int k) {
             }
             c.g[0] = float(g.x), c.g[1] = float(g.y), c.g[2] = float(g.z);
             for (int q = 0; q < 3; ++q) c.L[q] = float(L[q]), c.lo[q] = float(lo[q]), c.hi[q] = float(hi[q]);
+            for (int q = 0; q < 3; ++q) // a black channel takes the luminance's mean vector
+                for (int a = 0; a < 3; ++a) c.m[q][a] = L[q] > 0 ? float(mq[q][a] / L[q]) : c.mlen * c.c[a];
             set_sigma_points(c);
         }
 }

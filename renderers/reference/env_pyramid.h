@@ -25,12 +25,18 @@
 namespace iblcheck::truth {
 
 struct EnvCell {
-    float L[3];         // ∫ L dω over the cell (RGB)
-    float c[3];         // luminance-weighted centroid direction (unit; the geometric centre if black)
-    float cov[6];       // luminance-weighted second moment of the directions about c (xx xy xz yy yz zz)
-    float mlen;         // |mean direction vector| (< 1): the mean vector is mlen·c
-    float sp[4][3];     // the quadrature rule's points (lobe_quadrature.h): c ± √2·l_k, l_k the columns of
-    int np;             // the Cholesky factor of cov on c's tangent plane; 1 point (c) when cov vanishes
+    float L[3];     // ∫ L dω over the cell (RGB)
+    float c[3];     // luminance-weighted centroid direction (unit; the geometric centre if black)
+    float cov[6];   // luminance-weighted second moment of the directions about c (xx xy xz yy yz zz)
+    float mlen;     // |mean direction vector| (< 1): the mean vector is mlen·c
+    float sp[4][3]; // the quadrature rule's points (lobe_quadrature.h): c ± √2·l_k, l_k the columns of
+    int np;         // the Cholesky factor of cov on c's tangent plane; 1 point (c) when cov vanishes
+    float m[3][3];  // per channel q, the mean direction vector ∫L_q ω dω / ∫L_q dω
+    // Per channel q, the rule's weights on sp[0..3] are L_q·(1/4 + a, 1/4 − a, 1/4 + b, 1/4 − b) with
+    // (a, b) = wa[q]: the offsets that move the rule's first moment from the luminance's mean to channel q's
+    // own (|a|, |b| ≤ 1/4). A cell whose colour changes across it (sky beside foliage) is then integrated
+    // to second order in every channel, not only in luminance, with the same four BRDF evaluations.
+    float wa[3][2];
     float g[3];         // geometric centre direction (unit)
     float cos_radius;   // cos of the largest angle from g to the cell's edge
     float radius;       // that angle (acos of cos_radius, kept: the quadrature's guard compares angles)

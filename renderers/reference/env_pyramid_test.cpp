@@ -185,3 +185,50 @@ TEST(EnvPyramid, RadianceRangeBoundsTheCone) {
         }
     }
 }
+
+// The per-channel weights (EnvCell::wa): where the colour changes across a cell, each channel's rule has
+// that channel's own first moment — the tangent part of Σ_k w_qk·sp_k / L_q is the tangent part of the
+// channel's mean direction m_q — with the same four points as the luminance rule. Without the offsets
+// (equal weights, the luminance rule for every channel) the moment error is the colour's shift across the
+// cell; the test checks both, on cells where the offsets are not clamped (|a|, |b| < 1/4).
+TEST(EnvPyramid, ChannelWeightsReproduceEachChannelsMeanDirection) {
+    const int W = 64, H = 32;
+    Environment e;
+    e.spec = "two-colour";
+    e.equirect = cv::Mat(H, W, CV_32FC3);
+    for (int j = 0; j < H; ++j)
+        for (int i = 0; i < W; ++i) { // red rises along φ, blue along θ, green flat: three different centroids
+            const double phi = 2 * kPi * (i + 0.5) / W, th = kPi * (j + 0.5) / H;
+            e.equirect.at<cv::Vec3f>(j, i) = {float(1.2 + std::sin(th)), 0.5f, float(1.1 + std::sin(phi))};
+        }
+    EnvPyramid p(e);
+    int cells = 0;
+    double worst_new = 0, worst_old = 0;
+    for (int k = 1; k <= 3; ++k)
+        for (int j = 0; j < p.height(k); ++j)
+            for (int i = 0; i < p.width(k); ++i) {
+                const EnvCell& c = p.cell(k, i, j);
+                if (c.np != 4) continue;
+                const V3 cc{c.c[0], c.c[1], c.c[2]};
+                auto tangent = [&](V3 v) { return v - dot(v, cc) * cc; };
+                for (int q = 0; q < 3; ++q) {
+                    const double a = c.wa[q][0], b = c.wa[q][1];
+                    if (std::max(std::fabs(a), std::fabs(b)) > 0.2499) continue;
+                    const double w[4] = {0.25 + a, 0.25 - a, 0.25 + b, 0.25 - b};
+                    V3 rule{0, 0, 0}, plain{0, 0, 0};
+                    for (int s = 0; s < 4; ++s) {
+                        const V3 sp{c.sp[s][0], c.sp[s][1], c.sp[s][2]};
+                        rule = rule + w[s] * sp, plain = plain + 0.25 * sp;
+                    }
+                    const V3 want = tangent(V3{c.m[q][0], c.m[q][1], c.m[q][2]});
+                    worst_new = std::max(worst_new, std::sqrt(dot(tangent(rule) - want, tangent(rule) - want)) / c.radius);
+                    worst_old = std::max(worst_old, std::sqrt(dot(tangent(plain) - want, tangent(plain) - want)) / c.radius);
+                    ++cells;
+                }
+            }
+    std::printf("%d cell-channels: moment error / cell radius %.2e with the channel weights, %.2e without\n", cells, worst_new,
+                worst_old);
+    ASSERT_GT(cells, 300);
+    EXPECT_LT(worst_new, 1e-4);
+    EXPECT_GT(worst_old, 0.02); // the colour shift the offsets correct is real in this environment
+}

@@ -103,7 +103,11 @@ struct Integrand {
     // ≥ 0: four points matching the cell's luminance-weighted mean direction c and second moment C
     // (projected on c's tangent plane, Cholesky factor columns l₁, l₂): c ± √2·l_k, each weighted ∫L/4 —
     // exact for a BRDF quadratic over the cell, so fourth order where it is smooth (the unscented
-    // transform's sigma points); a point source gives four coincident points, evaluated once.
+    // transform's sigma points); a point source gives four coincident points, evaluated once. Each
+    // channel q reweights the same points, ∫L_q·(1/4 ± a_q, 1/4 ± b_q) (EnvCell::wa), so that its rule
+    // has the channel's own mean direction: a cell whose colour changes across it (blue sky beside
+    // green foliage) is then as accurate per channel as in luminance, which halved the evaluations per
+    // table node on Blender's forest (CONVERGENCE.md).
     // Sub-texel cells: 2x2 Gauss–Legendre of the bilinear radiance. A cell that straddles the horizon:
     // f·cos at the centroid of its part above, times that part's fraction (the cosine's kink would make
     // any smooth rule first order there, and hide an upper part whose points all fall below).
@@ -155,7 +159,10 @@ struct Integrand {
         }
         for (int k = 0; k < 4; ++k) lx[k] = cell->sp[k][0], ly[k] = cell->sp[k][1], lz[k] = cell->sp[k][2];
         fcos4(lobe, s, lx, ly, lz, f4);
-        for (int q = 0; q < 3; ++q) e[q] = 0.25 * L[q] * (f4[q][0] + f4[q][1] + f4[q][2] + f4[q][3]);
+        for (int q = 0; q < 3; ++q) {
+            const double a = cell->wa[q][0], b = cell->wa[q][1];
+            e[q] = L[q] * ((0.25 + a) * f4[q][0] + (0.25 - a) * f4[q][1] + (0.25 + b) * f4[q][2] + (0.25 - b) * f4[q][3]);
+        }
         evals += 4;
         return true;
     }
