@@ -7,7 +7,8 @@
 // RMSE (reference.h's definition), mean HDR-FLIP, worst pixel term, and each level's CPU time (user + sys of
 // the process while it rendered) and wall time. --save PREFIX writes PREFIX<k>.exr per level. --against
 // measures every level against a stored finest solution instead (--finer defaults to 0 then). --only keeps
-// the spheres whose label contains one of the given substrings (the others are left out of the scene).
+// the spheres whose label contains one of the given substrings (the others are left out of the scene;
+// a trailing '$' asks for the whole label: --only 'metal r=0$').
 #include <sys/resource.h>
 
 #include <chrono>
@@ -164,7 +165,8 @@ int main(int argc, char** argv) {
             kept.spheres.clear(), kept.labels.clear();
             for (size_t i = 0; i < scene.spheres.size(); ++i)
                 for (const std::string& o : only)
-                    if (scene.labels[i].find(o) != std::string::npos) {
+                    if (o.back() == '$' ? scene.labels[i] == o.substr(0, o.size() - 1)
+                                        : scene.labels[i].find(o) != std::string::npos) {
                         kept.spheres.push_back(scene.spheres[i]), kept.labels.push_back(scene.labels[i]);
                         break;
                     }

@@ -205,3 +205,34 @@ TEST(TruthRenderer, GoldenSidecarHasBoundAndNoAbsolutePaths) {
     EXPECT_EQ(g.meta["deterministic"], true);
     fs::remove_all(dir);
 }
+
+// A mirror sphere with F0 = 1 (F = 1 at every angle) under an orthographic camera maps image area to
+// solid angle with a constant Jacobian: dA = (R²/4)·dω (the projected area R²(n·v)dω_n over the
+// half-vector Jacobian dω = 4(n·v)dω_n), so the sphere's pixels sum to (R²/4)·∫L dω for any
+// environment — here a random-texel one, the worst case for the footprint's adaptive rule. The footprint
+// stops at the variation bound's depth (shade_pixel): ~(4/3)·4^depth points a pixel plus the rim's polar rules; without that
+// cap the texel edges drove it to tens of thousands more (measured: 1.4e5 a pixel on Blender's forest).
+TEST(TruthRenderer, MirrorPixelsSumToTheEnvironmentIntegralWithinTheDepthCap) {
+    Environment e;
+    e.spec = "random-texels", e.content_hash = "random-texels";
+    e.equirect = cv::Mat(128, 256, CV_32FC3);
+    cv::randu(e.equirect, cv::Scalar::all(0), cv::Scalar::all(4));
+    const EnvPyramid pyramid(e);
+    OptionMap o;
+    o.set("roughness", "0"), o.set("metallic", "1"), o.set("base_color", "1");
+    const Scene scene = build_scene("sphere", o);
+    const TruthAccuracy acc;
+    const TruthImage img = render_truth_level(scene, 32, 32, pyramid, e.content_hash, Lobes::all, acc, 2);
+    const double r2 = cv::sum(img.coverage)[0] / kPi; // exact coverage: Σ = πR²
+    double env_integral[3] = {0, 0, 0};
+    for (int j = 0; j < pyramid.height(0); ++j)
+        for (int i = 0; i < pyramid.width(0); ++i)
+            for (int q = 0; q < 3; ++q) env_integral[q] += pyramid.cell(0, i, j).L[q];
+    const cv::Scalar sum = cv::sum(img.image);
+    for (int q = 0; q < 3; ++q) EXPECT_NEAR(sum[q] / (r2 / 4 * env_integral[q]), 1.0, 2e-4) << "channel " << q;
+    const double covered = cv::countNonZero(img.coverage > 0);
+    const double per_pixel = double(img.footprint_points) / covered;
+    std::printf("mirror sphere, R = %.2f px: %.0f footprint points a covered pixel; Σ pixels / (R²/4 ∫L) = %.6f\n", std::sqrt(r2),
+                per_pixel, sum[1] / (r2 / 4 * env_integral[1]));
+    EXPECT_LT(per_pixel, 2 * std::pow(4.0, acc.bound_depth)); // measured 7375 (66006 without the cap)
+}
