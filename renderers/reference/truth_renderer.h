@@ -27,8 +27,9 @@ struct TruthAccuracy {
     double kappa = 2;              // lobe guards (quadrature and table), × the lobe's width (2 instead of 1:
                                    // 21 % less time, the same error: CONVERGENCE.md)
     int bound_depth = 6;           // footprint.h: the variation bound splits squares down to 2^-depth px
-    // The temporal sequences' accuracy: a bumped sphere's pixels average a wide cone of normals, so every
-    // control is looser (measured in CONVERGENCE.md, "The temporal truth").
+    // The temporal sequences' accuracy: a bumped sphere's pixels average a wide cone of normals; the
+    // normal table, shared by every frame, is tighter, the footprint looser (CONVERGENCE.md, "The
+    // temporal truth").
     static TruthAccuracy temporal();
     TruthAccuracy finer() const;
     nlohmann::json json() const;
