@@ -128,7 +128,7 @@ void shade_pixel(const SphereView& sv, const EnvPyramid& env, const NormalTable*
             const double radius = sv.normal_cone(x0, y0, s, n);
             return table->variation(n, radius);
         };
-        fp.min_depth = bumps ? 2 : 1; // bumps: a period is ~2 px
+        fp.min_depth = bumps ? 2 : 1;              // bumps: a period is ~2 px
         if (bumps) fp.max_depth = acc.bound_depth; // as the mirror's (above): the finer level goes one deeper
         const PixelIntegral pi = integrate_pixel(sv.disc(), px, py, g, bumps ? &b : nullptr, fp);
         for (int q = 0; q < 3; ++q) rgb[q] += pi.rgb[q];
