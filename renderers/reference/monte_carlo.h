@@ -111,7 +111,7 @@ ReferenceRender render_reference_full(const TestSpec& spec, const Environment* e
 //   (per-pixel relative error, Rousselle et al. 2011: the sun's few edge pixels do not dominate it).
 // This is the between-seeds figure; each render's own RMS error against the true image is ≈ it / √2.
 // mean_flip: hook for the FLIP metric (metrics/); not filled in here (the metrics library is not a
-// dependency of the reference), callers holding both images may compute it (the tool does).
+// dependency of the reference), callers holding both images may compute it (monte_carlo_golden.h does).
 // Issue 5's criterion: mean FLIP < 0.002 and relative RMSE < 0.005 between the seeds. What each
 // golden reaches, and at what cost, is in CONVERGENCE.md and in the golden's JSON (noise_floor.criterion).
 struct NoiseFloor {
