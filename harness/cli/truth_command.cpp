@@ -67,7 +67,7 @@ struct TruthArgs {
 // The golden's path (the golden store's key unless --out), refused if it or its sidecar exists without --force.
 std::string golden_path(const TruthArgs& a, const TestSpec& keyed) {
     namespace fs = std::filesystem;
-    const std::string exr =
+    std::string exr =
         a.out.empty() ? reference_key(keyed) + (a.frames > 0 ? "__frames=" + std::to_string(a.frames) : "") + ".exr" : a.out;
     if (!a.force)
         for (const fs::path& p : {fs::path(exr), fs::path(exr).replace_extension(".json")})
