@@ -23,8 +23,8 @@ EXPECTED_TIME="~6 min: 358 s wall, 634 s CPU (user), 2 threads, measured 2026-11
 if [[ ! -f "$BUILD_DIR/CMakeCache.txt" ]]; then
   cmake -S "$ROOT" -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
 fi
-cmake --build "$BUILD_DIR" -j2 --target iblcheck_reference_tool >/dev/null
-TOOL=$(find "$BUILD_DIR" -name iblcheck_reference_tool -type f -perm -u+x | head -1)
+cmake --build "$BUILD_DIR" -j2 --target iblcheck >/dev/null
+TOOL="$BUILD_DIR/iblcheck"
 mkdir -p "$OUT"
 # The committed goldens, kept aside to state how far each new one is from it (mean FLIP, relative RMSE).
 OLD=$(mktemp -d)
@@ -48,8 +48,8 @@ truth() { # scene env [key=value...]: the quadrature truth
   t0=$(date +%s)
   mapfile -t sets < <(sets_of "$@")
   mapfile -t cmp < <(compare_old "$name")
-  "$TOOL" --truth --scene "$scene" --env "$env" "${sets[@]}" --out "$OUT/$name.exr" "${cmp[@]}" \
-    --command "scripts/regenerate_reference_goldens.sh"
+  "$TOOL" truth --scene "$scene" --env "$env" "${sets[@]}" --out "$OUT/$name.exr" --force "${cmp[@]}" \
+    --command "scripts/regenerate_reference_goldens.sh" || [[ $? == 1 ]] # 1: written, criterion not met
   echo "[goldens] $name: $(( $(date +%s) - t0 )) s"
 }
 monte_carlo() { # scene env spp [key=value...]: the Monte Carlo integrator (seeds 0 and 1 for the noise floor)
@@ -58,9 +58,10 @@ monte_carlo() { # scene env spp [key=value...]: the Monte Carlo integrator (seed
   name=$(name_of "$scene" "$env" "$@")
   t0=$(date +%s)
   mapfile -t sets < <(sets_of "$@")
-  "$TOOL" --scene "$scene" --env "$env" --spp "$spp" --seed 0 --noise-floor "${sets[@]}" \
-    --out "$OUT/$name.exr" --meta "$OUT/$name.json" --command "scripts/regenerate_reference_goldens.sh (spp=$spp)"
-  if [[ -f "$OLD/$name.exr" ]]; then "$TOOL" --diff "$OUT/$name.exr" "$OLD/$name.exr" | head -1; fi
+  mapfile -t cmp < <(compare_old "$name")
+  "$TOOL" truth --integrator monte_carlo --scene "$scene" --env "$env" --spp "$spp" --seed 0 "${sets[@]}" \
+    --out "$OUT/$name.exr" --force "${cmp[@]}" --command "scripts/regenerate_reference_goldens.sh (spp=$spp)" \
+    || [[ $? == 1 ]] # 1: written, criterion not met
   echo "[goldens] $name: $(( $(date +%s) - t0 )) s"
 }
 if [[ "$TEMPORAL" != only ]]; then
@@ -77,13 +78,13 @@ fi
 if [[ "$TEMPORAL" == 1 || "$TEMPORAL" == only ]]; then
   for env in sky_sun studio; do
     t0=$(date +%s)
-    "$TOOL" --truth --frames 32 --scene bumpy_sphere --env "$env" --out "$OUT/bumpy_sphere__${env}__frames=32.exr" \
-      --command "TEMPORAL=only scripts/regenerate_reference_goldens.sh"
+    "$TOOL" truth --frames 32 --scene bumpy_sphere --env "$env" --out "$OUT/bumpy_sphere__${env}__frames=32.exr" \
+      --force --command "TEMPORAL=only scripts/regenerate_reference_goldens.sh"
     echo "[goldens] bumpy_sphere__${env}__frames=32: $(( $(date +%s) - t0 )) s"
   done
   t0=$(date +%s)
-  "$TOOL" --truth --frames 16 --scene sphere_field --env sky_sun --out "$OUT/sphere_field__sky_sun__frames=16.exr" \
-    --command "TEMPORAL=only scripts/regenerate_reference_goldens.sh"
+  "$TOOL" truth --frames 16 --scene sphere_field --env sky_sun --out "$OUT/sphere_field__sky_sun__frames=16.exr" \
+    --force --command "TEMPORAL=only scripts/regenerate_reference_goldens.sh"
   echo "[goldens] sphere_field__sky_sun__frames=16: $(( $(date +%s) - t0 )) s"
 fi
 # Wall time, and the CPU time of every render (user + sys of the finished children: the machine may be shared).

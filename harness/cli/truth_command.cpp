@@ -2,6 +2,12 @@
 // user's own .exr/.hdr) and writes it as a golden with its JSON sidecar (renderers/reference/truth_golden.h):
 // the error bound (two refinement levels' difference: relative RMSE, mean FLIP, per sphere, worst pixel)
 // and issue 16's criterion verdict. Progress and an ETA go to stderr, one updating line on a terminal.
+//   --frames N                  the temporal truth (frames stacked vertically in one golden)
+//   --integrator monte_carlo    the Monte Carlo integrator at --spp N, lighting seed --seed K, with its noise
+//                               floor against a second render with seed K + 1 (monte_carlo_golden.h);
+//                               --tiles WxH prints that noise floor per tile
+//   --compare OLD.exr           prints the mean FLIP and relative RMSE between the new golden and OLD
+// Nothing is overwritten without --force. Exit 0: written, criterion met; 1: written, criterion NOT met.
 #include <fmt/core.h>
 #include <unistd.h>
 
@@ -12,6 +18,7 @@
 #include "commands.h"
 #include "harness/common/errors.h"
 #include "harness/golden_store.h"
+#include "renderers/reference/monte_carlo_golden.h"
 #include "renderers/reference/truth_golden.h"
 
 namespace iblcheck::cli {
@@ -48,78 +55,171 @@ class ProgressLine {
     double last_t_ = -1;
     std::chrono::steady_clock::time_point t0_ = std::chrono::steady_clock::now();
 };
+// The command line, as parsed.
+struct TruthArgs {
+    std::string scene = "roughness_sweep", env, out, integrator = "quadrature", compare, tiles, command;
+    std::vector<std::string> sets;
+    bool force = false;
+    int frames = 0, spp = kReferenceDefaultSpp, seed = 0;
+    bool spp_given = false, seed_given = false;
+};
+
+// The golden's path (the golden store's key unless --out), refused if it or its sidecar exists without --force.
+std::string golden_path(const TruthArgs& a, const TestSpec& keyed) {
+    namespace fs = std::filesystem;
+    std::string exr =
+        a.out.empty() ? reference_key(keyed) + (a.frames > 0 ? "__frames=" + std::to_string(a.frames) : "") + ".exr" : a.out;
+    if (!a.force)
+        for (const fs::path& p : {fs::path(exr), fs::path(exr).replace_extension(".json")})
+            if (fs::exists(p)) throw UsageError(p.string() + ": exists; pass --force to overwrite");
+    return exr;
+}
+
+// The regenerating command as recorded: --command's text, else this command without absolute paths (a file
+// environment by its name).
+std::string recorded_command(const TruthArgs& a, const std::string& env) {
+    if (!a.command.empty()) return a.command;
+    std::string c = fmt::format("iblcheck truth --scene {} --env {}", a.scene, env);
+    if (a.integrator == "monte_carlo") c += fmt::format(" --integrator monte_carlo --spp {} --seed {}", a.spp, a.seed);
+    for (auto& s : a.sets) c += " --set " + s;
+    if (a.frames > 0) c += " --frames " + std::to_string(a.frames);
+    return c;
+}
+
+std::string sidecar(const std::string& exr) { return std::filesystem::path(exr).replace_extension(".json").string(); }
+
+// WxH, e.g. 48x48.
+std::pair<int, int> parse_tiles(const std::string& t) {
+    int w = 0, h = 0;
+    char rest = 0;
+    if (std::sscanf(t.c_str(), "%dx%d%c", &w, &h, &rest) != 2 || w < 1 || h < 1)
+        throw UsageError("--tiles: expected WxH, e.g. 48x48, got '" + t + "'");
+    return {w, h};
+}
+
+void check_combinations(const TruthArgs& a) {
+    const bool mc = a.integrator == "monte_carlo";
+    if (!mc && (a.spp_given || a.seed_given || !a.tiles.empty()))
+        throw UsageError("--spp, --seed and --tiles are options of --integrator monte_carlo");
+    if (mc && a.frames > 0) throw UsageError("--frames: the temporal truth is the quadrature's (no --integrator monte_carlo)");
+    if (mc && a.spp < 1) throw UsageError("--spp: must be >= 1");
+    if (!a.tiles.empty()) parse_tiles(a.tiles);
+}
+
+void print_comparison(const std::string& new_exr, const std::string& old_exr) {
+    const truth::GoldenDifference d = truth::golden_difference(new_exr, old_exr);
+    fmt::print("against {}: mean FLIP {:.5f}, relative RMSE {:.4f} %\n", old_exr, d.mean_flip, 100 * d.relative_rmse);
+}
+
+int run_sequence(const truth::GoldenRequest& req, int frames, ProgressLine& line) {
+    truth::SequenceRequest sr;
+    sr.spec = req.spec, sr.frames = frames, sr.bound_frames = {0, frames / 2}, sr.out_exr = req.out_exr;
+    sr.command = req.command;
+    sr.progress = req.progress;
+    const nlohmann::json m = truth::write_truth_sequence_golden(sr);
+    line.done();
+    const auto& b = m["error_bound"];
+    fmt::print("wrote {} and {} ({} frames of {}x{}, {:.1f} s)\n", req.out_exr, sidecar(req.out_exr), frames,
+               m["width"].get<int>(), m["height"].get<int>(), m["time_s"].get<double>());
+    fmt::print("error bound (frames {} and {} against the finer level): relative RMSE <= {:.4f} %, mean FLIP <= {:.5f}, "
+               "LDR FLIP <= {:.5f}\n",
+               sr.bound_frames[0], sr.bound_frames[1], 100 * b["relative_rmse_max"].get<double>(),
+               b["mean_flip_max"].get<double>(), b["mean_flip_ldr_max"].get<double>());
+    return kExitPass;
+}
+
+int run_quadrature(const truth::GoldenRequest& req, ProgressLine& line) {
+    const truth::GoldenWritten g = truth::write_truth_golden(req);
+    line.done();
+    const auto& b = g.meta["error_bound"];
+    fmt::print("wrote {} and {} ({}x{}, {:.1f} s)\n", req.out_exr, sidecar(req.out_exr), g.meta["width"].get<int>(),
+               g.meta["height"].get<int>(), g.meta["time_s"].get<double>());
+    fmt::print("error bound (coarser vs finer level): relative RMSE {:.4f} %, mean FLIP {:.5f}, worst pixel {:.4f} "
+               "({:.2f} % relative) -> criterion {}\n",
+               100 * b["relative_rmse"].get<double>(), g.mean_flip, b["worst_pixel"].get<double>(),
+               100 * b["worst_pixel_relative"].get<double>(), g.criterion_met ? "met" : "NOT met");
+    for (const auto& s : b["per_sphere"])
+        fmt::print("  {:<16} relative RMSE {:.4f} %  mean FLIP {:.5f}  worst pixel {:.4f}\n", s["label"].get<std::string>(),
+                   100 * s["relative_rmse"].get<double>(), s["mean_flip"].get<double>(), s["worst_pixel"].get<double>());
+    return g.criterion_met ? kExitPass : kExitRegression;
+}
+
+int run_monte_carlo(const TruthArgs& a, const truth::GoldenRequest& req) {
+    truth::MonteCarloGoldenRequest mr;
+    mr.spec = req.spec, mr.spp = a.spp, mr.seed = a.seed, mr.out_exr = req.out_exr, mr.command = req.command;
+    fmt::print(stderr, "[truth] Monte Carlo, {} spp, seeds {} and {} (noise floor)...\n", a.spp, a.seed, a.seed + 1);
+    const truth::MonteCarloGoldenWritten g = truth::write_monte_carlo_golden(mr);
+    const auto& nf = g.meta["noise_floor"];
+    fmt::print("wrote {} and {} ({}x{}, {} spp, {:.1f} s)\n", req.out_exr, sidecar(req.out_exr), g.meta["width"].get<int>(),
+               g.meta["height"].get<int>(), a.spp, g.meta["time_s"].get<double>());
+    fmt::print("noise floor (seeds {} and {}): relative RMSE {:.4f} %, mean FLIP {:.5f} -> criterion {}\n", a.seed, a.seed + 1,
+               100 * nf["relative_rmse"].get<double>(), nf["mean_flip"].get<double>(), g.criterion_met ? "met" : "NOT met");
+    if (!a.tiles.empty()) {
+        const auto [w, h] = parse_tiles(a.tiles);
+        fmt::print("{}", truth::noise_floor_by_tile(g, w, h));
+    }
+    return g.criterion_met ? kExitPass : kExitRegression;
+}
+
+int run_truth(const TruthArgs& a) {
+    check_combinations(a);
+    truth::GoldenRequest req;
+    req.spec.method = "reference";
+    req.spec.scene = a.scene;
+    req.spec.env = a.env;
+    for (auto& s : a.sets) req.spec.options.set_from_string(s);
+    // The file name from the golden store's key, with the environment as recorded (a path: its name).
+    TestSpec keyed = req.spec;
+    keyed.env = truth::portable_env_spec(a.env);
+    req.out_exr = golden_path(a, keyed);
+    req.command = recorded_command(a, keyed.env);
+    int rc;
+    if (a.integrator == "monte_carlo") {
+        rc = run_monte_carlo(a, req);
+    } else {
+        ProgressLine line(a.scene + " / " + keyed.env);
+        req.progress = [&line](double f) { line(f); };
+        rc = a.frames > 0 ? run_sequence(req, a.frames, line) : run_quadrature(req, line);
+    }
+    if (!a.compare.empty()) print_comparison(req.out_exr, a.compare);
+    return rc;
+}
 } // namespace
 
 void register_truth_command(CLI::App& app, int& exit_code) {
-    auto* cmd = app.add_subcommand("truth", "Render the deterministic quadrature truth of a scene and write it as a "
-                                            "reference golden + JSON sidecar with its error bound");
-    static std::string scene = "roughness_sweep", env, out;
-    static std::vector<std::string> sets;
-    static bool force = false;
-    static int frames = 0;
-    cmd->add_option("--scene", scene, "Scene name (iblcheck list)")->capture_default_str();
-    cmd->add_option("--env", env, "Environment: a spec (iblcheck list) or a path to your own .exr/.hdr")->required();
-    cmd->add_option("--out", out,
+    auto* cmd = app.add_subcommand("truth", "Render the deterministic quadrature truth (or the Monte Carlo integrator) of "
+                                            "a scene and write it as a reference golden + JSON sidecar with its error bound");
+    static TruthArgs a;
+    cmd->add_option("--scene", a.scene, "Scene name (iblcheck list)")->capture_default_str();
+    cmd->add_option("--env", a.env, "Environment: a spec (iblcheck list) or a path to your own .exr/.hdr")->required();
+    cmd->add_option("--out", a.out,
                     "Golden EXR to write (default: <reference key>.exr in the current folder); the "
                     "sidecar is the same path with .json");
-    cmd->add_option("--set", sets,
+    cmd->add_option("--set", a.sets,
                     "Option key=value (repeatable): material options, env_rotation, threads, "
                     "truth_tolerance (the coarser level's pixel tolerance)");
-    cmd->add_option("--frames", frames,
+    cmd->add_option("--frames", a.frames,
                     "Render the temporal truth: frames 0..N-1 (option frame) stacked vertically "
                     "in one golden, as the temporal suite reads it (reference/<key>__frames=N.exr)");
-    cmd->add_flag("--force", force, "Overwrite existing output files");
-    cmd->callback([&exit_code] {
-        truth::GoldenRequest req;
-        req.spec.method = "reference";
-        req.spec.scene = scene;
-        req.spec.env = env;
-        for (auto& s : sets) req.spec.options.set_from_string(s);
-        namespace fs = std::filesystem;
-        // The file name from the golden store's key, with the environment as recorded (a path: its name).
-        TestSpec keyed = req.spec;
-        keyed.env = truth::portable_env_spec(env);
-        req.out_exr =
-            out.empty() ? reference_key(keyed) + (frames > 0 ? "__frames=" + std::to_string(frames) : "") + ".exr" : out;
-        const fs::path json = fs::path(req.out_exr).replace_extension(".json");
-        if (!force)
-            for (const fs::path& p : {fs::path(req.out_exr), json})
-                if (fs::exists(p)) throw UsageError(p.string() + ": exists; pass --force to overwrite");
-        // The regenerating command as recorded: no absolute paths (a file environment by its name).
-        req.command = fmt::format("iblcheck truth --scene {} --env {}", scene, keyed.env);
-        for (auto& s : sets) req.command += " --set " + s;
-        ProgressLine line(scene + " / " + keyed.env);
-        req.progress = [&line](double f) { line(f); };
-        if (frames > 0) {
-            truth::SequenceRequest sr;
-            sr.spec = req.spec, sr.frames = frames, sr.bound_frames = {0, frames / 2}, sr.out_exr = req.out_exr;
-            sr.command = req.command + " --frames " + std::to_string(frames);
-            sr.progress = req.progress;
-            const nlohmann::json m = truth::write_truth_sequence_golden(sr);
-            line.done();
-            const auto& b = m["error_bound"];
-            fmt::print("wrote {} and {} ({} frames of {}x{}, {:.1f} s)\n", req.out_exr, json.string(), frames,
-                       m["width"].get<int>(), m["height"].get<int>(), m["time_s"].get<double>());
-            fmt::print("error bound (frames {} and {} against the finer level): relative RMSE <= {:.4f} %, mean FLIP <= {:.5f}, "
-                       "LDR FLIP <= {:.5f}\n",
-                       sr.bound_frames[0], sr.bound_frames[1], 100 * b["relative_rmse_max"].get<double>(),
-                       b["mean_flip_max"].get<double>(), b["mean_flip_ldr_max"].get<double>());
-            exit_code = kExitPass;
-            return;
-        }
-        const truth::GoldenWritten g = truth::write_truth_golden(req);
-        line.done();
-        const auto& b = g.meta["error_bound"];
-        fmt::print("wrote {} and {} ({}x{}, {:.1f} s)\n", req.out_exr, json.string(), g.meta["width"].get<int>(),
-                   g.meta["height"].get<int>(), g.meta["time_s"].get<double>());
-        fmt::print("error bound (coarser vs finer level): relative RMSE {:.4f} %, mean FLIP {:.5f}, worst pixel {:.4f} "
-                   "({:.2f} % relative) -> criterion {}\n",
-                   100 * b["relative_rmse"].get<double>(), g.mean_flip, b["worst_pixel"].get<double>(),
-                   100 * b["worst_pixel_relative"].get<double>(), g.criterion_met ? "met" : "NOT met");
-        for (const auto& s : b["per_sphere"])
-            fmt::print("  {:<16} relative RMSE {:.4f} %  mean FLIP {:.5f}  worst pixel {:.4f}\n", s["label"].get<std::string>(),
-                       100 * s["relative_rmse"].get<double>(), s["mean_flip"].get<double>(), s["worst_pixel"].get<double>());
-        exit_code = g.criterion_met ? kExitPass : kExitRegression;
+    cmd->add_option("--integrator", a.integrator,
+                    "quadrature (the deterministic truth) or monte_carlo (the Monte Carlo integrator, with its noise "
+                    "floor between seeds K and K+1 in the sidecar; the near-mirror golden)")
+        ->check(CLI::IsMember({"quadrature", "monte_carlo"}))
+        ->capture_default_str();
+    cmd->add_option("--spp", a.spp, "monte_carlo: lighting samples per pixel")->capture_default_str();
+    cmd->add_option("--seed", a.seed, "monte_carlo: the golden's lighting seed K (the noise floor renders K+1 too)")
+        ->capture_default_str();
+    cmd->add_option("--tiles", a.tiles,
+                    "monte_carlo: also print the noise floor per WxH tile (48x48: one sphere of the "
+                    "roughness sweep)");
+    cmd->add_option("--compare", a.compare, "Print the mean FLIP and relative RMSE between the new golden and OLD.exr");
+    cmd->add_option("--command", a.command,
+                    "The regenerating command recorded in the sidecar (default: this iblcheck truth command)");
+    cmd->add_flag("--force", a.force, "Overwrite existing output files");
+    cmd->callback([&exit_code, cmd] {
+        a.spp_given = cmd->count("--spp") > 0;
+        a.seed_given = cmd->count("--seed") > 0;
+        exit_code = run_truth(a);
     });
 }
 

@@ -1,6 +1,5 @@
-// The Monte Carlo integrator's environment distribution and its random numbers (monte_carlo.h): moved
-// unchanged from reference.cpp.
-#include "renderers/reference/monte_carlo.h"
+// The Monte Carlo integrator's environment distribution and its random numbers (env_distribution.h).
+#include "renderers/reference/env_distribution.h"
 
 #include <algorithm>
 #include <cmath>
@@ -73,6 +72,16 @@ EnvDistribution::EnvDistribution(const Environment& env, double compensation) {
     w_ = m.cols, h_ = m.rows;
     double a = double(env.rotation_deg) * kPi / 180;
     rot_c_ = std::cos(a), rot_s_ = std::sin(a);
+    const std::vector<double> mass = build_pixel_cdfs(m, compensation);
+    if (total_ <= 0) return;
+    build_pixel_pdf(mass);
+    build_guide_tables();
+    build_cells();
+}
+
+// Marginal (rows) and conditional (columns) CDFs of the pixel masses, 3x3-max luminance × the row's
+// solid angle / (2π/W), and total_; returns each pixel's mass (the CDFs' increments, as summed).
+std::vector<double> EnvDistribution::build_pixel_cdfs(const cv::Mat& m, double compensation) {
     std::vector<double> lum(size_t(w_) * h_);
     for (int j = 0; j < h_; ++j)
         for (int i = 0; i < w_; ++i) {
@@ -121,15 +130,21 @@ EnvDistribution::EnvDistribution(const Environment& env, double compensation) {
         marginal_cdf_[j + 1] = marginal_cdf_[j] + cdf[w_];
     }
     total_ = marginal_cdf_[h_];
-    if (total_ <= 0) return;
-    // Solid-angle pdf of each pixel, P_pixel / Ω_pixel, stored once (float: the same value is used by
-    // sample() and pdf(), so the estimator stays exactly consistent; rounding is a 1e-7 relative effect).
+    return prob;
+}
+
+// Solid-angle pdf of each pixel, P_pixel / Ω_pixel, stored once (float: the same value is used by
+// sample() and pdf(), so the estimator stays exactly consistent; rounding is a 1e-7 relative effect).
+void EnvDistribution::build_pixel_pdf(const std::vector<double>& prob) {
     for (int j = 0; j < h_; ++j)
         for (int i = 0; i < w_; ++i)
             pdf_[size_t(j) * w_ + i] = float(prob[size_t(j) * w_ + i] / total_ * double(w_) / (2 * kPi * row_dcos_[j]));
-    // Guide tables (Chen & Asau 1974 "cutpoint" method): guide[g] = first index whose cumulative mass
-    // exceeds g/G of the total, so inverting the CDF is O(1) expected and still monotone in u (the
-    // Sobol stratification carries over to the environment, which an alias table would lose).
+}
+
+// Guide tables (Chen & Asau 1974 "cutpoint" method): guide[g] = first index whose cumulative mass
+// exceeds g/G of the total, so inverting the CDF is O(1) expected and still monotone in u (the
+// Sobol stratification carries over to the environment, which an alias table would lose).
+void EnvDistribution::build_guide_tables() {
     auto build_guide = [](const double* cdf, int n, std::vector<int>& guide, size_t off) {
         const double tot = cdf[n];
         int i = 0;
@@ -145,10 +160,12 @@ EnvDistribution::EnvDistribution(const Environment& env, double compensation) {
     for (int j = 0; j < h_; ++j)
         if (conditional_cdf_[size_t(j) * (w_ + 1) + w_] > 0)
             build_guide(&conditional_cdf_[size_t(j) * (w_ + 1)], w_, conditional_guide_, size_t(j) * w_);
+}
 
-    // Coarse cells for the windowed distribution: at most 128x64 (2.8 degrees), each a block of pixels.
-    // (64x32 was measured first: studio sweep at 1024 spp, mean FLIP between seeds 0.0073 -> 0.0067 and
-    // relative RMSE 0.90 % -> 0.83 % with the finer cells, for 17 % more time spent building windows.)
+// Coarse cells for the windowed distribution: at most 128x64 (2.8 degrees), each a block of pixels.
+// (64x32 was measured first: studio sweep at 1024 spp, mean FLIP between seeds 0.0073 -> 0.0067 and
+// relative RMSE 0.90 % -> 0.83 % with the finer cells, for 17 % more time spent building windows.)
+void EnvDistribution::build_cells() {
     cw_ = std::min(128, w_), ch_ = std::min(64, h_);
     cell_i0_.resize(cw_ + 1), cell_j0_.resize(ch_ + 1);
     for (int c = 0; c <= cw_; ++c) cell_i0_[c] = int(int64_t(c) * w_ / cw_);
@@ -162,11 +179,6 @@ EnvDistribution::EnvDistribution(const Environment& env, double compensation) {
     cell_sin_rad_.assign(nc, 0.0);
     cell_row_off_.assign(nc, 0);
     cell_row_cdf_.clear();
-    auto env_dir = [&](double u, double v, double d[3]) { // equirect uv -> world direction
-        double phi = (u - 0.5) * 2 * kPi, th = v * kPi;
-        double e[3] = {std::sin(th) * std::sin(phi), std::cos(th), -std::sin(th) * std::cos(phi)};
-        env_to_world(e, d);
-    };
     for (int cy = 0; cy < ch_; ++cy)
         for (int cx = 0; cx < cw_; ++cx) {
             const int c = cy * cw_ + cx;
@@ -179,24 +191,31 @@ EnvDistribution::EnvDistribution(const Environment& env, double compensation) {
             }
             cell_mass_[c] = cell_row_cdf_.back() / total_;
             cell_omega_[c] = (i1 - i0) * (2 * kPi / w_) * (std::cos(j0 * kPi / h_) - std::cos(j1 * kPi / h_));
-            // Centre = the direction of the uv centre; angular radius = the largest angle to the cell's
-            // corners and edge midpoints (+1 % and 1e-4 rad of slack).
-            double* d = &cell_dir_[size_t(c) * 3];
-            const double u0 = double(i0) / w_, u1 = double(i1) / w_, v0 = double(j0) / h_, v1 = double(j1) / h_;
-            env_dir(0.5 * (u0 + u1), 0.5 * (v0 + v1), d);
-            double min_cos = 1;
-            for (double fu : {0.0, 0.5, 1.0})
-                for (double fv : {0.0, 0.5, 1.0}) {
-                    double q[3];
-                    env_dir(u0 + fu * (u1 - u0), v0 + fv * (v1 - v0), q);
-                    min_cos = std::min(min_cos, d[0] * q[0] + d[1] * q[1] + d[2] * q[2]);
-                }
-            double rad = std::acos(std::clamp(min_cos, -1.0, 1.0)) * 1.01 + 1e-4;
-            rad = std::min(rad, kPi);
-            cell_rad_[c] = rad, cell_cos_rad_[c] = std::cos(rad), cell_sin_rad_[c] = std::sin(rad);
+            set_cell_cone(c, double(i0) / w_, double(i1) / w_, double(j0) / h_, double(j1) / h_);
         }
 }
 
+// Cell c's centre = the direction of its uv centre; angular radius = the largest angle to the cell's
+// corners and edge midpoints (+1 % and 1e-4 rad of slack).
+void EnvDistribution::set_cell_cone(int c, double u0, double u1, double v0, double v1) {
+    auto env_dir = [&](double u, double v, double d[3]) { // equirect uv -> world direction
+        double phi = (u - 0.5) * 2 * kPi, th = v * kPi;
+        double e[3] = {std::sin(th) * std::sin(phi), std::cos(th), -std::sin(th) * std::cos(phi)};
+        env_to_world(e, d);
+    };
+    double* d = &cell_dir_[size_t(c) * 3];
+    env_dir(0.5 * (u0 + u1), 0.5 * (v0 + v1), d);
+    double min_cos = 1;
+    for (double fu : {0.0, 0.5, 1.0})
+        for (double fv : {0.0, 0.5, 1.0}) {
+            double q[3];
+            env_dir(u0 + fu * (u1 - u0), v0 + fv * (v1 - v0), q);
+            min_cos = std::min(min_cos, d[0] * q[0] + d[1] * q[1] + d[2] * q[2]);
+        }
+    double rad = std::acos(std::clamp(min_cos, -1.0, 1.0)) * 1.01 + 1e-4;
+    rad = std::min(rad, kPi);
+    cell_rad_[c] = rad, cell_cos_rad_[c] = std::cos(rad), cell_sin_rad_[c] = std::sin(rad);
+}
 // First index i in [0, n) with cdf[i + 1] > t (the upper_bound), from the guide; never an empty bin.
 static inline int invert_cdf(const double* cdf, const int* guide, int n, double t) {
     int g = int(t / cdf[n] * n);

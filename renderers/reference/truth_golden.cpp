@@ -12,6 +12,7 @@
 #include "metrics/display_transform.h"
 #include "metrics/flip.h"
 #include "metrics/image_io.h"
+#include "renderers/reference/monte_carlo.h"
 
 namespace iblcheck::truth {
 
@@ -20,13 +21,26 @@ std::string portable_env_spec(const std::string& spec) {
     return std::filesystem::path(spec).filename().string();
 }
 
-namespace {
 std::string utc_now() {
     char date[64];
     const std::time_t now = std::time(nullptr);
     std::strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
     return date;
 }
+
+GoldenDifference golden_difference(const std::string& new_exr, const std::string& old_exr) {
+    const cv::Mat a = read_image(new_exr).pixels, o = read_image(old_exr).pixels;
+    check_same_size(a, o, new_exr, old_exr);
+    cv::Mat cov(a.rows, a.cols, CV_32FC1, cv::Scalar(0)); // covered: the background is exactly 0
+    for (int y = 0; y < a.rows; ++y)
+        for (int x = 0; x < a.cols; ++x) {
+            const cv::Vec3f& p = a.at<cv::Vec3f>(y, x);
+            if (p[0] > 0 || p[1] > 0 || p[2] > 0) cov.at<float>(y, x) = 1;
+        }
+    return {compute_flip_hdr(o, a, FlipOptions{}).mean, relative_rmse(a, o, cov)};
+}
+
+namespace {
 
 // Mean FLIP per sphere (over the pixels the sphere covers most of).
 void add_sphere_flip(nlohmann::json& per_sphere, const cv::Mat& errmap, const cv::Mat& sphere) {

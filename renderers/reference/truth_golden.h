@@ -1,7 +1,7 @@
 // Writes one quadrature-truth golden: the EXR and its JSON sidecar, with the error bound (the two
 // refinement levels' difference as relative RMSE, mean FLIP, per sphere and worst pixel) and issue
-// 16's criterion verdict. Shared by `iblcheck truth` and iblcheck_reference_tool (the regeneration
-// script). Links the metrics (FLIP), which the integrator itself does not.
+// 16's criterion verdict. Written by `iblcheck truth` (harness/cli/truth_command.cpp, which the
+// regeneration script runs). Links the metrics (FLIP), which the integrator itself does not.
 #pragma once
 #include <string>
 
@@ -51,5 +51,17 @@ void write_golden_files(const std::string& exr_path, const cv::Mat& image, const
 // The environment as recorded in a sidecar: its spec, but a file path reduced to its file name (no
 // absolute machine paths in goldens), with the content hash that identifies it.
 std::string portable_env_spec(const std::string& spec);
+
+// The current UTC time as a sidecar records it (2026-11-23T09:24:43Z).
+std::string utc_now();
+
+// How far a new golden is from an older one (`iblcheck truth --compare OLD.exr`): mean HDR-FLIP with the
+// old golden as the reference, and relative RMSE (monte_carlo.h's definition) over the new golden's
+// covered pixels (the background is exactly 0).
+struct GoldenDifference {
+    double mean_flip = 0;
+    double relative_rmse = 0;
+};
+GoldenDifference golden_difference(const std::string& new_exr, const std::string& old_exr);
 
 } // namespace iblcheck::truth
