@@ -55,8 +55,8 @@ json Artefacts::images(const std::string& test, const std::string& golden, const
             {"test_exr", exr(test)}, {"golden_exr", exr(golden)}, {"error_exr", exr(heatmap)}};
 }
 
-json Artefacts::layout(const TestSpec& spec, int width, int height) const {
-    SphereLayout l = sphere_layout(spec, width, height);
+json Artefacts::layout(const SphereCoverage& coverage) const {
+    SphereLayout l = sphere_layout(coverage);
     if (l.ids.empty()) return nullptr;
     fs::create_directories(dir);
     cv::Mat ids;

@@ -33,7 +33,8 @@ struct Artefacts {
     // A comparison's images: {test, golden, heatmap} PNGs and their EXRs (test_exr, golden_exr, error_exr).
     static nlohmann::json images(const std::string& test, const std::string& golden, const std::string& heatmap);
     // Which sphere is where (the report names the sphere under the pointer): an 8-bit id map.
-    nlohmann::json layout(const TestSpec& spec, int width, int height) const;
+    // From the render's coverage; null when it has more spheres than the map holds.
+    nlohmann::json layout(const SphereCoverage& coverage) const;
     // The full-precision render, kept beside the results when the test did not pass.
     void keep_float_render(const cv::Mat& image) const;
 };

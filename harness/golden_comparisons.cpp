@@ -17,9 +17,10 @@ namespace {
 
 // Where the error concentrates, for a person: "worst 16x16 block at (160,16) on metal r=0.3 ...".
 // Recorded on the comparison ({x, y, flip, sphere}); a failing comparison's message says it too.
-void note_worst_block(Comparison& c, const TestSpec& spec, const FlipResult& flip, int width, int height) {
-    std::string sphere =
-        sphere_at(spec, width, height, std::min(flip.block_x + 8, width - 1), std::min(flip.block_y + 8, height - 1));
+// The sphere is the one the render shows at the block's centre (its coverage).
+void note_worst_block(Comparison& c, const SphereCoverage& coverage, const FlipResult& flip) {
+    const int width = coverage.ids.cols, height = coverage.ids.rows;
+    std::string sphere = sphere_at(coverage, std::min(flip.block_x + 8, width - 1), std::min(flip.block_y + 8, height - 1));
     c.worst_block = {{"x", flip.block_x}, {"y", flip.block_y}, {"flip", flip.block_max}, {"sphere", sphere}};
     if (c.verdict == Verdict::fail)
         c.message += fmt::format("; worst 16x16 block at ({},{}){} with mean FLIP {:.4g}", flip.block_x, flip.block_y,
@@ -37,12 +38,13 @@ BaselineOutcome missing_baseline(const TestCase& tc, const GoldenStore& store) {
 }
 
 // The render against one approved baseline `g`, with its report images.
-Comparison judge_against_baseline(const TestCase& tc, const cv::Mat& image, const Golden& g, const Artefacts& art,
+Comparison judge_against_baseline(const TestCase& tc, const RenderResult& rr, const Golden& g, const Artefacts& art,
                                   int flip_threads) {
+    const cv::Mat& image = rr.image;
     if (g.image.size() != image.size()) return judge_size("baseline", image.cols, image.rows, g.image.cols, g.image.rows);
     FlipResult flip;
     Comparison c = judge_baseline(compare_images(g.image, image, flip_threads, &flip), tc.baseline_tolerances);
-    note_worst_block(c, tc.spec, flip, image.cols, image.rows);
+    note_worst_block(c, rr.coverage, flip);
     if (art) {
         std::string tag = g.label.empty() ? "baseline" : "baseline@" + safe_file_name(g.label);
         // A render bit-identical to its baseline (the usual pass) shares the test's EXR.
@@ -78,13 +80,13 @@ std::vector<Check> judge_costs(const TestCase& tc, const RenderResult& rr, const
 
 } // namespace
 
-BaselineOutcome judge_against_baselines(const TestCase& tc, const cv::Mat& image, const GoldenStore& store, const Artefacts& art,
-                                        int flip_threads) {
+BaselineOutcome judge_against_baselines(const TestCase& tc, const RenderResult& rr, const GoldenStore& store,
+                                        const Artefacts& art, int flip_threads) {
     std::vector<Golden> goldens = store.baselines(tc.name);
     if (goldens.empty()) return missing_baseline(tc, store);
     std::vector<Comparison> candidates;
     for (const Golden& g : goldens) {
-        Comparison c = judge_against_baseline(tc, image, g, art, flip_threads);
+        Comparison c = judge_against_baseline(tc, rr, g, art, flip_threads);
         c.golden = store.relative(g.image_path);
         c.label = g.label;
         candidates.push_back(std::move(c));
@@ -108,8 +110,9 @@ Comparison cost_comparison(const TestCase& tc, const RenderResult& rr, const Bas
     return cost;
 }
 
-Comparison judge_against_truth(const TestCase& tc, const cv::Mat& image, const Golden& ref, const GoldenStore& store,
+Comparison judge_against_truth(const TestCase& tc, const RenderResult& rr, const Golden& ref, const GoldenStore& store,
                                const json& approved_accuracy, const Artefacts& art, int flip_threads, json& r) {
+    const cv::Mat& image = rr.image;
     if (ref.image.size() != image.size()) {
         Comparison c = judge_size("reference", image.cols, image.rows, ref.image.cols, ref.image.rows);
         c.golden = store.relative(ref.image_path);
@@ -119,12 +122,12 @@ Comparison judge_against_truth(const TestCase& tc, const cv::Mat& image, const G
     json metrics = compare_images(ref.image, image, flip_threads, &flip);
     Comparison c = judge_reference(metrics, approved_accuracy, tc.reference_band);
     c.golden = store.relative(ref.image_path);
-    note_worst_block(c, tc.spec, flip, image.cols, image.rows);
+    note_worst_block(c, rr.coverage, flip);
     r["accuracy"] = {{"flip_mean", flip.mean},
                      {"ssim", metrics["ssim"]["mean"]},
                      {"golden", c.golden},
                      {"noise_floor", ref.provenance.value("noise_floor", json())}};
-    if (json ps = per_sphere_errors(tc.spec, flip.errmap); !ps.is_null()) r["per_sphere"] = ps;
+    if (json ps = per_sphere_errors(rr.coverage, flip.errmap); !ps.is_null()) r["per_sphere"] = ps;
     if (art) {
         c.images = Artefacts::images(art.rel + "test.png", art.png("reference.png", ref.image, false),
                                      art.heatmap("reference_flip.png", flip.errmap));

@@ -1,7 +1,7 @@
 // A render against its goldens, each comparison measured (image_compare.h) and judged (verdict.h):
 // the approved baselines (any one may pass the test), the cost recorded with the chosen baseline,
 // and the truth (the reference golden). Each comparison carries its report images when the test
-// writes artefacts, and the worst 16x16 block with the sphere it lies on.
+// writes artefacts, and the worst 16x16 block with the sphere it lies on (the render's coverage).
 #pragma once
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
@@ -21,8 +21,8 @@ struct BaselineOutcome {
 
 // Any of the test's approved baselines may pass it; the outcome is the one that did, or the
 // closest one (missing-golden when the test has none).
-BaselineOutcome judge_against_baselines(const TestCase& tc, const cv::Mat& image, const GoldenStore& store, const Artefacts& art,
-                                        int flip_threads);
+BaselineOutcome judge_against_baselines(const TestCase& tc, const RenderResult& rr, const GoldenStore& store,
+                                        const Artefacts& art, int flip_threads);
 
 // The render's cost per pixel against the cost recorded with the chosen baseline, as one
 // comparison of kind "cost". A baseline without a recorded cost cannot gate it: that is a failure
@@ -31,7 +31,7 @@ Comparison cost_comparison(const TestCase& tc, const RenderResult& rr, const Bas
 
 // Accuracy against the reference golden `ref`, judged by the band around the baseline's approved
 // accuracy. Records the test's "accuracy" (and "per_sphere" for multi-sphere scenes) in `r`.
-Comparison judge_against_truth(const TestCase& tc, const cv::Mat& image, const Golden& ref, const GoldenStore& store,
+Comparison judge_against_truth(const TestCase& tc, const RenderResult& rr, const Golden& ref, const GoldenStore& store,
                                const nlohmann::json& approved_accuracy, const Artefacts& art, int flip_threads,
                                nlohmann::json& r);
 

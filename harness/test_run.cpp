@@ -91,16 +91,16 @@ struct TestRun {
 };
 
 // The render as the report shows it: test.png (+ its EXR) and which sphere is where.
-void record_images(TestRun& t, const cv::Mat& image) {
-    t.r["image"] = t.art.png("test.png", image);
+void record_images(TestRun& t, const RenderResult& rr) {
+    t.r["image"] = t.art.png("test.png", rr.image);
     t.r["image_exr"] = Artefacts::exr(t.r["image"]);
-    t.r["layout"] = t.art.layout(t.tc.spec, image.cols, image.rows);
+    t.r["layout"] = t.art.layout(rr.coverage);
 }
 
 // The approved baselines and, when there is one, the cost approved with it and the platform it was
 // blessed on (a difference is named in the message of a test that does not pass).
 BaselineOutcome check_baselines(TestRun& t, const RenderResult& rr) {
-    BaselineOutcome base = judge_against_baselines(t.tc, rr.image, t.store, t.art, t.flip_threads);
+    BaselineOutcome base = judge_against_baselines(t.tc, rr, t.store, t.art, t.flip_threads);
     t.r["comparisons"].push_back(to_json(base.comparison));
     if (base.missing) {
         t.add(base.comparison.verdict, base.comparison.message);
@@ -121,10 +121,10 @@ json approved_accuracy(const BaselineOutcome& base) { return base.golden.provena
 
 // Against the truth, when the store holds the scene's reference golden; returns its image (empty
 // when there is none).
-cv::Mat check_reference(TestRun& t, const cv::Mat& image, const BaselineOutcome& base) {
+cv::Mat check_reference(TestRun& t, const RenderResult& rr, const BaselineOutcome& base) {
     auto ref = t.store.reference(t.tc.spec);
     if (!ref) return {};
-    Comparison c = judge_against_truth(t.tc, image, *ref, t.store, approved_accuracy(base), t.art, t.flip_threads, t.r);
+    Comparison c = judge_against_truth(t.tc, rr, *ref, t.store, approved_accuracy(base), t.art, t.flip_threads, t.r);
     t.r["comparisons"].push_back(to_json(c));
     t.add(c.verdict, c.message.empty() ? "" : "accuracy: " + c.message);
     return ref->image;
@@ -169,9 +169,9 @@ json run_test(const TestCase& tc, Worker& w, const GoldenStore& store, const std
         record_render(t.r, rr);
         repeat_timings(t.r, tc, w, timing_repeats);
         if (NonFinite nf = find_non_finite(rr.image); nf.count) throw NonFiniteRender("render: " + nf.describe());
-        if (t.art) record_images(t, rr.image);
+        if (t.art) record_images(t, rr);
         const BaselineOutcome base = tc.baseline ? check_baselines(t, rr) : BaselineOutcome{};
-        const cv::Mat reference = tc.reference ? check_reference(t, rr.image, base) : cv::Mat();
+        const cv::Mat reference = tc.reference ? check_reference(t, rr, base) : cv::Mat();
         if (tc.temporal.frames > 0) check_temporal(t);
         if (tc.stability.enabled) check_stability(t, rr.image, reference, base);
     } catch (const ShaderCompileError& e) {
