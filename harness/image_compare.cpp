@@ -6,7 +6,6 @@
 #include "metrics/flip_json.h"
 #include "metrics/psnr.h"
 #include "metrics/ssim.h"
-#include "renderers/scenes/scene.h"
 
 using nlohmann::json;
 
@@ -29,61 +28,40 @@ json compare_images(const cv::Mat& golden, const cv::Mat& test, int flip_threads
     return j;
 }
 
-namespace {
-// Pixel -> sphere index (-1 for background), from the same camera and intersection the renderers use.
-int sphere_index(const Scene& scene, int width, int height, int x, int y) {
-    Vec3f o, d;
-    camera_ray(scene, width, height, x + 0.5, y + 0.5, o, d);
-    Hit h = intersect(scene, o, d);
-    return h.hit ? h.sphere : -1;
-}
-
-std::string sphere_label(const Scene& scene, int i) {
-    return size_t(i) < scene.labels.size() ? scene.labels[size_t(i)] : "sphere " + std::to_string(i);
-}
-} // namespace
-
-json per_sphere_errors(const TestSpec& spec, const cv::Mat& errmap) {
-    Scene scene = build_scene(spec.scene, spec.options);
-    if (scene.spheres.size() < 2) return json();
-    std::vector<double> sum(scene.spheres.size(), 0.0);
-    std::vector<long> count(scene.spheres.size(), 0);
+json per_sphere_errors(const SphereCoverage& coverage, const cv::Mat& errmap) {
+    const size_t n = coverage.spheres.size();
+    if (n < 2) return json();
+    std::vector<double> sum(n, 0.0);
+    std::vector<long> count(n, 0);
     for (int y = 0; y < errmap.rows; ++y)
         for (int x = 0; x < errmap.cols; ++x) {
-            int id = sphere_index(scene, errmap.cols, errmap.rows, x, y);
+            int id = coverage.ids.at<int>(y, x);
             if (id < 0) continue;
             sum[size_t(id)] += errmap.at<float>(y, x);
             count[size_t(id)]++;
         }
     json out = json::array();
-    for (size_t i = 0; i < scene.spheres.size(); ++i) {
+    for (size_t i = 0; i < n; ++i) {
         if (!count[i]) continue;
-        out.push_back({{"label", sphere_label(scene, int(i))},
-                       {"roughness", scene.spheres[i].material.roughness},
-                       {"metallic", scene.spheres[i].material.metallic},
-                       {"flip_mean", sum[i] / double(count[i])}});
+        const SphereCoverage::Sphere& s = coverage.spheres[i];
+        out.push_back(
+            {{"label", s.label}, {"roughness", s.roughness}, {"metallic", s.metallic}, {"flip_mean", sum[i] / double(count[i])}});
     }
     return out;
 }
 
-SphereLayout sphere_layout(const TestSpec& spec, int width, int height) {
-    Scene scene = build_scene(spec.scene, spec.options);
+SphereLayout sphere_layout(const SphereCoverage& coverage) {
     SphereLayout out;
-    if (scene.spheres.size() > 254) return out; // does not fit the 8-bit map: no layout
-    out.ids = cv::Mat(height, width, CV_8U);
-    for (int y = 0; y < height; ++y)
-        for (int x = 0; x < width; ++x) out.ids.at<uchar>(y, x) = uchar(sphere_index(scene, width, height, x, y) + 1);
-    for (size_t i = 0; i < scene.spheres.size(); ++i)
-        out.spheres.push_back({{"label", sphere_label(scene, int(i))},
-                               {"roughness", scene.spheres[i].material.roughness},
-                               {"metallic", scene.spheres[i].material.metallic}});
+    if (coverage.spheres.size() > 254) return out; // does not fit the 8-bit map: no layout
+    coverage.ids.convertTo(out.ids, CV_8U, 1.0, 1.0);
+    for (const SphereCoverage::Sphere& s : coverage.spheres)
+        out.spheres.push_back({{"label", s.label}, {"roughness", s.roughness}, {"metallic", s.metallic}});
     return out;
 }
 
-std::string sphere_at(const TestSpec& spec, int width, int height, int x, int y) {
-    Scene scene = build_scene(spec.scene, spec.options);
-    int id = sphere_index(scene, width, height, x, y);
-    return id < 0 ? "" : sphere_label(scene, id);
+std::string sphere_at(const SphereCoverage& coverage, int x, int y) {
+    int id = coverage.ids.at<int>(y, x);
+    return id < 0 ? "" : coverage.spheres[size_t(id)].label;
 }
 
 } // namespace iblcheck

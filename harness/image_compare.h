@@ -1,5 +1,6 @@
 // Metrics of a render against a golden, as results JSON (the keys `iblcheck compare --json`
-// prints), and the per-sphere breakdown of an error map. Measures only: harness/verdict.h judges.
+// prints), and the per-sphere breakdown of an error map by the render's sphere coverage (which the
+// renderer reports: renderers/scenes/coverage.h). Measures only: harness/verdict.h judges.
 #pragma once
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
@@ -14,19 +15,19 @@ namespace iblcheck {
 nlohmann::json compare_images(const cv::Mat& golden, const cv::Mat& test, int flip_threads, FlipResult* flip_out = nullptr);
 
 // Mean FLIP per sphere of a multi-sphere scene (null for single-sphere scenes), labelled with the
-// scene's sphere names.
-nlohmann::json per_sphere_errors(const TestSpec& spec, const cv::Mat& errmap);
+// scene's sphere names. `coverage`: the render's (RenderResult::coverage), the error map's size.
+nlohmann::json per_sphere_errors(const SphereCoverage& coverage, const cv::Mat& errmap);
 
-// Where each sphere lies in a render of `spec`, for the report's "what is under the pointer":
-// `ids` (CV_8U, width x height) holds 0 for the background and i + 1 for sphere i (at most 254
-// spheres); `spheres` lists {label, roughness, metallic} in that order.
+// Where each sphere lies in a render, for the report's "what is under the pointer": `ids` (CV_8U,
+// the render's size) holds 0 for the background and i + 1 for sphere i (at most 254 spheres, else
+// empty); `spheres` lists {label, roughness, metallic} in that order.
 struct SphereLayout {
     cv::Mat ids;
     nlohmann::json spheres = nlohmann::json::array();
 };
-SphereLayout sphere_layout(const TestSpec& spec, int width, int height);
+SphereLayout sphere_layout(const SphereCoverage& coverage);
 
-// The sphere under pixel (x, y) of a render of `spec` ("metal r=0.3"), or "" for the background.
-std::string sphere_at(const TestSpec& spec, int width, int height, int x, int y);
+// The sphere under pixel (x, y) of a render ("metal r=0.3"), or "" for the background.
+std::string sphere_at(const SphereCoverage& coverage, int x, int y);
 
 } // namespace iblcheck

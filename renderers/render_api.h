@@ -26,6 +26,17 @@ struct PassTiming {
     bool precompute = false; // environment-dependent work done once (prefilter, SH, LUT)
 };
 
+// Which sphere each pixel shows (renderers/scenes/coverage.h): the harness's per-sphere errors, the
+// sphere a worst block lies on, and the report's id map come from it.
+struct SphereCoverage {
+    struct Sphere {
+        std::string label; // "metal r=0.3"
+        float roughness = 0, metallic = 0;
+    };
+    cv::Mat ids;                 // CV_32S, the image's size: the sphere at the pixel's centre, -1 background
+    std::vector<Sphere> spheres; // the scene's spheres, in index order
+};
+
 struct RenderResult {
     cv::Mat image; // CV_32FC3, linear HDR
     std::vector<PassTiming> timings;
@@ -39,6 +50,7 @@ struct RenderResult {
     // would store it: texels and bytes in its storage format. 0 where a method has none.
     uint64_t texel_count = 0;
     uint64_t texture_bytes = 0;
+    SphereCoverage coverage; // filled by Renderer::render() for every method
 };
 
 } // namespace iblcheck

@@ -9,6 +9,7 @@
 #include "renderers/mobile/mobile_renderer.h"
 #include "renderers/reference/reference.h"
 #include "renderers/sampled/sampled_renderer.h"
+#include "renderers/scenes/coverage.h"
 #include "renderers/scenes/scene.h"
 #include "renderers/vulkan/shader_compiler.h"
 
@@ -93,6 +94,7 @@ RenderResult Renderer::render(const TestSpec& spec) {
         r.provenance["shader_tree_hash"] = vk::shader_tree_hash();
         r.provenance["driver"] = driver_json();
     }
+    r.coverage = sphere_coverage(build_scene(spec.scene, spec.options), r.image.cols, r.image.rows);
     return r;
 }
 

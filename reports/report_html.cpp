@@ -37,6 +37,8 @@ std::string value_text(const json& v) {
     return v.dump();
 }
 
+std::string run_commit(const json& r) { return str(r, "commit") + (r.value("dirty", false) ? "+dirty" : ""); }
+
 const std::vector<std::string>& verdict_order() {
     static const std::vector<std::string> order{"fail", "error", "missing-golden", "improved", "pass"};
     return order;

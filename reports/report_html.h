@@ -1,4 +1,5 @@
-// Internal to the report (report_writer.cpp, report_card.cpp, report_charts.cpp): lenient JSON
+// Internal to the report (report_writer.cpp, report_card.cpp, report_viewer.cpp, report_charts.cpp,
+// since_baselines.cpp): lenient JSON
 // accessors (the results are validated before rendering), the image copier, and the pieces of the
 // page each file writes.
 #pragma once
@@ -22,6 +23,9 @@ std::optional<double> num(const json& j, const char* k);
 const json& sub(const json& j, const char* k);
 inline std::string e(std::string_view s) { return html_escape(s); }
 std::string value_text(const json& v);
+
+// A run's commit as the page names it: "abc1234" or "abc1234+dirty".
+std::string run_commit(const json& r);
 
 // fail, error, missing-golden, improved, pass: the order of the page.
 const std::vector<std::string>& verdict_order();
@@ -85,6 +89,10 @@ void viewer_html(std::string& o, PageContext& ctx, const json& t, const ViewerSp
 void test_card(std::string& o, const json& t, size_t idx, PageContext& ctx, const Trend& trend, bool expanded);
 // A passing test's thumbnail tile in the grid; clicking it opens the card.
 void test_tile(std::string& o, const json& t, size_t idx, PageContext& ctx);
+
+// The summary's table of what changed since the baselines were blessed (since_baselines.cpp):
+// shader tree, commit, driver and CPU class, blessed with and now; "" when no baseline was judged.
+std::string since_baselines_html(const json& results, const std::vector<const json*>& tests);
 
 // The charts tab: cost against accuracy, wall time (median and range), error against roughness,
 // flicker against FLIP, each as small multiples. tests[i] is the page's test i (its id test_id(i)).

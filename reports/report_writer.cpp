@@ -36,8 +36,6 @@ struct History {
     static constexpr size_t kMaxRuns = 30;
 };
 
-std::string run_commit(const json& r) { return str(r, "commit") + (r.value("dirty", false) ? "+dirty" : ""); }
-
 Trend trend_for(const History& h, const std::string& test) {
     Trend t;
     if (h.runs.size() < 2) return t;
@@ -83,92 +81,6 @@ Trend trend_for(const History& h, const std::string& test) {
     }
     t.any = t.flip.points + t.frame.points + t.cost.points > 0;
     return t;
-}
-
-// ---- "what changed since the baselines" ----
-// Each test's baseline comparison records the sidecar of the golden it was judged against
-// ("approved": commit, date, shader tree hash, driver, CPU class); the render records its own.
-std::string since_baselines_html(const json& results, const std::vector<const json*>& tests) {
-    std::map<std::string, int> shader_then, commit_then, driver_then, cpu_then;
-    std::map<std::string, std::string> commit_date;
-    std::set<std::string> shader_now;
-    int judged = 0, shader_changed = 0, driver_changed = 0, cpu_changed = 0;
-    const std::string driver_now = str(sub(results, "driver"), "driver_info"), cpu_now = str(results, "cpu_class");
-    for (const json* t : tests) {
-        const std::string sh = str(sub(*t, "provenance"), "shader_tree_hash");
-        if (!sh.empty()) shader_now.insert(sh);
-        if (!sub(*t, "comparisons").is_array()) continue;
-        for (const json& c : (*t)["comparisons"]) {
-            const json& a = sub(c, "approved");
-            if (str(c, "kind") != "baseline" || !a.is_object()) continue;
-            ++judged;
-            const std::string s = str(a, "shader_tree_hash"), cm = str(a, "commit"), d = str(a, "driver_info"),
-                              cpu = str(a, "cpu_class");
-            if (!s.empty()) {
-                shader_then[s]++;
-                if (!sh.empty() && s != sh) ++shader_changed;
-            }
-            if (!cm.empty()) {
-                commit_then[cm]++;
-                if (commit_date[cm].empty() || str(a, "date") > commit_date[cm]) commit_date[cm] = str(a, "date");
-            }
-            if (!d.empty()) {
-                driver_then[d]++;
-                if (!driver_now.empty() && d != driver_now) ++driver_changed;
-            }
-            if (!cpu.empty()) {
-                cpu_then[cpu]++;
-                if (!cpu_now.empty() && cpu != cpu_now) ++cpu_changed;
-            }
-        }
-    }
-    if (!judged) return "";
-    auto list = [](const std::map<std::string, int>& m, size_t cut, const std::map<std::string, std::string>* dates = nullptr) {
-        std::vector<std::pair<int, std::string>> v;
-        for (auto& [k, n] : m) v.push_back({n, k});
-        std::sort(v.rbegin(), v.rend());
-        std::string s;
-        for (size_t i = 0; i < v.size() && i < 3; ++i) {
-            std::string k = v[i].second.substr(0, cut);
-            if (dates && dates->count(v[i].second)) k += ", " + dates->at(v[i].second).substr(0, 10);
-            s += (s.empty() ? "" : "; ") +
-                 fmt::format("<span class=\"mono\">{}</span> ({} test{})", e(k), v[i].first, v[i].first == 1 ? "" : "s");
-        }
-        if (v.size() > 3) s += fmt::format("; {} more", v.size() - 3);
-        return s;
-    };
-    auto status = [&](int changed) {
-        return changed ? fmt::format("<td class=\"changed\">changed for {} of {}</td>", changed, judged)
-                       : std::string("<td class=\"same\">same</td>");
-    };
-    std::string now_shader;
-    for (auto& s : shader_now) now_shader += (now_shader.empty() ? "" : ", ") + s.substr(0, 16);
-    std::string o = "<table class=\"since\"><tr><th>since the baselines</th><th>blessed with</th><th>this run</th><th></th></tr>";
-    if (!shader_then.empty())
-        o += fmt::format("<tr><th>shader tree</th><td>{}</td><td class=\"mono\">{}</td>{}</tr>", list(shader_then, 16),
-                         e(now_shader), status(shader_changed));
-    if (!commit_then.empty()) {
-        const std::string now = run_commit(results);
-        int changed = 0;
-        for (auto& [k, n] : commit_then) {
-            std::string bare = k.size() > 6 && k.substr(k.size() - 6) == "-dirty" ? k.substr(0, k.size() - 6) : k;
-            if (bare.substr(0, std::min(bare.size(), size_t(7))) !=
-                str(results, "commit").substr(0, std::min(size_t(7), str(results, "commit").size())))
-                changed += n;
-        }
-        o += fmt::format("<tr><th>commit</th><td>{}</td><td class=\"mono\">{}</td>{}</tr>", list(commit_then, 12, &commit_date),
-                         e(now),
-                         changed ? fmt::format("<td>{} of {} blessed at another commit</td>", changed, judged)
-                                 : std::string("<td class=\"same\">same</td>"));
-    }
-    if (!driver_then.empty())
-        o += fmt::format("<tr><th>driver</th><td>{}</td><td>{}</td>{}</tr>", list(driver_then, 60), e(driver_now),
-                         status(driver_changed));
-    if (!cpu_then.empty())
-        o += fmt::format("<tr><th>CPU class</th><td>{}</td><td class=\"mono\">{}</td>{}</tr>", list(cpu_then, 40), e(cpu_now),
-                         status(cpu_changed));
-    o += "</table>";
-    return o;
 }
 
 // The suite argument the bless commands use ("--suite 'ci'"), from a test's bless command.

@@ -3,104 +3,26 @@
 
 #include <unistd.h>
 
-#include <cmath>
 #include <cstdlib>
 #include <fstream>
 
 #include <fmt/format.h>
 
 #include "metrics/display_transform.h"
-#include "metrics/flip.h"
 #include "metrics/image_io.h"
 #include "reports/report_writer.h"
+#include "tests/report_fixture_images.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
 
 namespace iblcheck::testutil {
 
+using namespace fixture;
+
 const std::string kEvilName = "mobile.evil.<script>alert('x')</script>&\"q\"";
 
 namespace {
-
-// A row of spheres (or two rows), linear RGB: shaded discs, a hot highlight on each when `sun`.
-cv::Mat spheres(int w, int h, int rows, float gain, bool sun) {
-    cv::Mat m(h, w, CV_32FC3, cv::Scalar(0.05f, 0.05f, 0.06f));
-    const int per_row = w / 48, r = std::min(20, h / (2 * rows) - 2);
-    for (int row = 0; row < rows; ++row)
-        for (int i = 0; i < per_row; ++i) {
-            const int cx = 24 + 48 * i, cy = h / (2 * rows) + row * h / rows;
-            for (int y = cy - r; y <= cy + r; ++y)
-                for (int x = cx - r; x <= cx + r; ++x) {
-                    const double d2 = double((x - cx) * (x - cx) + (y - cy) * (y - cy)) / (r * r);
-                    if (d2 > 1 || x < 0 || y < 0 || x >= w || y >= h) continue;
-                    const float s = float(std::sqrt(1 - d2)) * gain;
-                    cv::Vec3f c = row == 0 ? cv::Vec3f(0.9f, 0.6f + 0.02f * i, 0.4f) : cv::Vec3f(0.7f, 0.7f, 0.7f);
-                    c *= s * (0.6f + 0.15f * float(i));
-                    const double hx = x - (cx - r / 3), hy = y - (cy - r / 3);
-                    if (sun && hx * hx + hy * hy < 4) c += cv::Vec3f(2500.0f, 2300.0f, 2100.0f);
-                    m.at<cv::Vec3f>(y, x) = c;
-                }
-        }
-    return m;
-}
-
-// Sphere ids of spheres(): 0 background, 1 + row * per_row + i.
-cv::Mat sphere_ids(int w, int h, int rows) {
-    cv::Mat ids(h, w, CV_32F, cv::Scalar(0));
-    const int per_row = w / 48, r = std::min(20, h / (2 * rows) - 2);
-    for (int row = 0; row < rows; ++row)
-        for (int i = 0; i < per_row; ++i) {
-            const int cx = 24 + 48 * i, cy = h / (2 * rows) + row * h / rows;
-            for (int y = std::max(0, cy - r); y <= std::min(h - 1, cy + r); ++y)
-                for (int x = std::max(0, cx - r); x <= std::min(w - 1, cx + r); ++x)
-                    if ((x - cx) * (x - cx) + (y - cy) * (y - cy) <= r * r)
-                        ids.at<float>(y, x) = float(1 + row * per_row + i) / 255.0f;
-        }
-    return ids;
-}
-
-json sphere_list(int per_row, int rows) {
-    json a = json::array();
-    for (int row = 0; row < rows; ++row)
-        for (int i = 0; i < per_row; ++i) {
-            const double rough = per_row > 1 ? double(i) / (per_row - 1) : 0.5;
-            a.push_back({{"label", fmt::format("{} r={}", row == 0 ? "metal" : "dielectric", std::round(rough * 10) / 10)},
-                         {"roughness", rough},
-                         {"metallic", row == 0 ? 1.0 : 0.0}});
-        }
-    return a;
-}
-
-// A FLIP-like error map: relative luminance difference, at most 1.
-cv::Mat error_map(const cv::Mat& a, const cv::Mat& b) {
-    cv::Mat e(a.size(), CV_32F);
-    for (int y = 0; y < a.rows; ++y)
-        for (int x = 0; x < a.cols; ++x) {
-            const cv::Vec3f p = a.at<cv::Vec3f>(y, x), q = b.at<cv::Vec3f>(y, x);
-            const float la = p[0] + p[1] + p[2], lb = q[0] + q[1] + q[2];
-            e.at<float>(y, x) = std::min(1.0f, 2.0f * std::fabs(la - lb) / (la + lb + 1e-3f));
-        }
-    return e;
-}
-
-void write_image(const fs::path& root, const std::string& rel, const cv::Mat& linear) {
-    fs::create_directories((root / rel).parent_path());
-    write_png((root / rel).string(), display_transform(linear));
-    write_exr_half((root / (rel.substr(0, rel.rfind('.')) + ".exr")).string(), linear);
-}
-void write_error(const fs::path& root, const std::string& rel, const cv::Mat& err) {
-    fs::create_directories((root / rel).parent_path());
-    write_png((root / rel).string(), magma_heatmap(err));
-    write_exr_half((root / (rel.substr(0, rel.rfind('.')) + ".exr")).string(), err);
-}
-std::string exr(const std::string& png) { return png.substr(0, png.rfind('.')) + ".exr"; }
-
-json images(const std::string& dir, const std::string& golden) {
-    const std::string t = "images/" + dir + "/test.png", g = "images/" + dir + "/" + golden + ".png",
-                      h = "images/" + dir + "/" + golden + "_flip.png";
-    return {{"test", t}, {"golden", g}, {"heatmap", h}, {"test_exr", exr(t)}, {"golden_exr", exr(g)}, {"error_exr", exr(h)}};
-}
 
 json comparison(const std::string& kind, const std::string& dir, const std::string& verdict, double flip) {
     return json{{"kind", kind},
@@ -175,290 +97,215 @@ json per_sphere(double scale) {
     return a; // 8 spheres
 }
 
+// The folder of this process's small run, removed when the test process ends (set
+// IBLCHECK_KEEP_TMP=1 to look at the report).
+SmallRun small_run_folders() {
+    SmallRun f;
+    f.root = fs::temp_directory_path() / ("iblcheck_test_report_" + std::to_string(::getpid()));
+    fs::remove_all(f.root);
+    static const fs::path cleanup = f.root;
+    if (!std::getenv("IBLCHECK_KEEP_TMP"))
+        std::atexit([] {
+            std::error_code ec;
+            fs::remove_all(cleanup, ec);
+        });
+    f.results_dir = f.root / "run";
+    f.out_dir = f.root / "report";
+    return f;
+}
+
+// t1: a passing sampled test with per-sphere errors and repeated timings.
+json sampled_pass_test() {
+    json t1 = make_test("sampled", "roughness_sweep", "studio", "samples=64", "pass", "t1");
+    t1["accuracy"] = {{"flip_mean", 0.011}, {"golden", "reference/roughness_sweep__studio.exr"}};
+    t1["frame_ms"] = 31.0;
+    t1["frame_ms_samples"] = {24.0, 31.0, 70.0};
+    t1["precompute_ms"] = 4.0;
+    t1["texture_fetches_per_pixel"] = 64;
+    t1["cost"] = {{"spirv_instructions_per_pixel", 54000.0}, {"texture_fetches_per_pixel", 64}};
+    t1["per_sphere"] = per_sphere(0.3);
+    return t1;
+}
+
+// t2: the failing test: baseline and accuracy, a driver mismatch, stability, a shader tree changed
+// since its baseline was blessed.
+json failing_test() {
+    json t2 = make_test("mobile", "roughness_sweep", "studio", "dominant_dir=lagarde", "fail", "t2");
+    t2["message"] = "baseline: flip.mean 0.0123 > 0.0100 (+0.0023); worst 16x16 block at (96,16)";
+    t2["driver_mismatch"] = "golden made with Mesa 22.3.5, this run Mesa 22.3.6";
+    t2["accuracy"] = {{"flip_mean", 0.052}, {"golden", "reference/roughness_sweep__studio.exr"}};
+    t2["frame_ms"] = 3.2;
+    t2["precompute_ms"] = 40.1;
+    t2["texture_fetches_per_pixel"] = 2.5;
+    t2["cost"] = {{"spirv_instructions_per_pixel", 6300.0}, {"texture_fetches_per_pixel", 2.5}};
+    t2["texture_bytes"] = 1048512; // the prefiltered chain, RGBA16F
+    t2["texel_count"] = 131064;
+    t2["per_sphere"] = per_sphere(1.0);
+    t2["stability"] = {{"noise_floor", {{"flip.mean", 0.0004}}}, {"margins", {{"flip.mean", 25.0}}}, {"flaky", false}};
+    t2["comparisons"][0]["approved"] = {{"commit", "c3"},
+                                        {"date", "2026-11-13T03:00:00Z"},
+                                        {"shader_tree_hash", "aaaa"},
+                                        {"driver_info", "Mesa 22.3.5"},
+                                        {"cpu_class", "avx2"}};
+    t2["provenance"] = {{"shader_tree_hash", "bbbb"}};
+    json ref = comparison("reference", "t2", "pass", 0.052);
+    ref["checks"] = json::array({{{"metric", "accuracy.flip.mean"},
+                                  {"value", 0.052},
+                                  {"approved", 0.030},
+                                  {"min", 0.027},
+                                  {"max", 0.033},
+                                  {"status", "fail"},
+                                  {"message", "accuracy.flip.mean 0.052 outside"}}});
+    ref["verdict"] = "fail";
+    t2["comparisons"].push_back(ref);
+    return t2;
+}
+
+// t3 improved (ASTC-sized texture), t4 missing-golden, t5 error (no image).
+void improved_missing_error_tests(json& tests) {
+    json t3 = make_test("mobile", "roughness_sweep", "studio", "dominant_dir=none", "improved", "t3");
+    t3["accuracy"] = {{"flip_mean", 0.061}};
+    t3["frame_ms"] = 3.0;
+    t3["precompute_ms"] = 38.0;
+    t3["texture_fetches_per_pixel"] = 2.0;
+    t3["cost"] = {{"spirv_instructions_per_pixel", 6200.0}};
+    t3["texture_bytes"] = 62976; // ASTC 6x6
+    tests.push_back(t3);
+
+    json t4 = make_test("mobile", "furnace", "constant", "", "missing-golden", "t4");
+    t4["comparisons"] = json::array(); // no golden: nothing to compare, the rendering alone
+    tests.push_back(t4);
+
+    json t5 = make_test("sampled", "broken", "sky_sun", "", "error", "t5");
+    t5["message"] = "shader compile failed: prefilter.glsl:12: 'foo' : undeclared identifier";
+    t5["comparisons"] = json::array();
+    t5["accuracy"] = nullptr;
+    t5.erase("image");
+    t5.erase("image_exr");
+    tests.push_back(t5);
+}
+
+// t6 (mobile, with reference frames) and t7 (sampled): 12-frame temporal tests.
+void temporal_tests(json& tests) {
+    json t6 = make_test("mobile", "rotation", "sky_sun", "temporal", "pass", "t6");
+    t6["options"] = json::object();
+    t6["accuracy"] = {{"flip_mean", 0.03}};
+    t6["frame_ms"] = 3.5;
+    t6["precompute_ms"] = 41.0;
+    t6["texture_fetches_per_pixel"] = 2.5;
+    t6["temporal"] = {{"frames", json::array()},
+                      {"reference_frames", json::array()},
+                      {"flicker", 0.01},
+                      {"variation_ratio", 1.3},
+                      {"flip_mean", 0.02}};
+    for (int i = 0; i < 12; ++i) {
+        t6["temporal"]["frames"].push_back(fmt::format("images/t6/frame{:03d}.png", i));
+        t6["temporal"]["reference_frames"].push_back(fmt::format("images/t6/ref{:03d}.png", i));
+    }
+    tests.push_back(t6);
+
+    json t7 = make_test("sampled", "rotation", "sky_sun", "temporal", "pass", "t7");
+    t7["options"] = json::object();
+    t7["accuracy"] = {{"flip_mean", 0.014}};
+    t7["frame_ms"] = 28.0;
+    t7["precompute_ms"] = 3.0;
+    t7["texture_fetches_per_pixel"] = 64;
+    t7["temporal"] = {{"frames", t6["temporal"]["frames"]}, {"flicker", 0.004}, {"flip_mean", 0.012}};
+    tests.push_back(t7);
+}
+
+// The evil name (HTML in the name and the message), and t9, a reference test whose heatmap is missing.
+void evil_and_reference_tests(json& tests) {
+    json t8 = make_test("mobile", "evil", "studio", "", "pass", "evil");
+    t8["name"] = kEvilName;
+    t8["message"] = "<b>bold</b> & \"quoted\"";
+    t8["accuracy"] = {{"flip_mean", 0.08}};
+    t8["frame_ms"] = 2.0;
+    t8["cost"] = {{"spirv_instructions_per_pixel", 4000.0}};
+    tests.push_back(t8);
+
+    json t9 = make_test("reference", "roughness_sweep", "studio", "", "pass", "t9");
+    t9["comparisons"][0]["images"]["heatmap"] = "images/t9/does_not_exist.png"; // a placeholder, not an error
+    t9["comparisons"][0]["images"].erase("error_exr");
+    t9["frame_ms"] = 5000.0;
+    tests.push_back(t9);
+}
+
+// The results document around `tests`, as the harness writes it.
+json small_run_results(const json& tests) {
+    return {{"schema", "iblcheck-results/1"},
+            {"suite", "ci"},
+            {"command", "iblcheck run --suite ci --out report"},
+            {"started", "2026-11-22T15:40:00Z"},
+            {"total_s", 41.2},
+            {"commit", "f554dd9"},
+            {"dirty", true},
+            {"cpu_class", "avx2"},
+            {"driver",
+             {{"device", "llvmpipe (LLVM 15.0.6, 256 bits)"},
+              {"driver", "llvmpipe"},
+              {"driver_info", "Mesa 22.3.6 (LLVM 15.0.6)"},
+              {"mesa", "22.3.6"},
+              {"llvm", "15.0.6"},
+              {"api", "1.3.230"}}},
+            {"counts", {{"pass", 5}, {"fail", 1}, {"improved", 1}, {"missing-golden", 1}, {"error", 1}}},
+            {"tests", tests}};
+}
+
+// Images: linear EXRs and their PNGs, error maps, sphere id maps, t6's frames.
+void write_small_run_images(const fs::path& results_dir) {
+    const int W = 192, H = 48;
+    for (const char* d : {"t1", "t2", "t3", "t4", "t5", "t6", "t7", "evil", "t9"}) {
+        const cv::Mat test = spheres(W, H, 1, 1.0f, false), base = spheres(W, H, 1, 1.1f, false);
+        write_image(results_dir, std::string("images/") + d + "/test.png", test);
+        write_image(results_dir, std::string("images/") + d + "/baseline.png", base);
+        write_error(results_dir, std::string("images/") + d + "/baseline_flip.png", error_map(test, base));
+        write_image(results_dir, std::string("images/") + d + "/reference.png", base);
+        write_error(results_dir, std::string("images/") + d + "/reference_flip.png", error_map(test, base));
+        write_png((results_dir / "images" / d / "spheres.png").string(), sphere_ids(W, H, 1));
+    }
+    for (int i = 0; i < 12; ++i) {
+        cv::Mat fr = spheres(96, 48, 1, 1.0f + 0.1f * float(i % 3 == 1), false), rf = spheres(96, 48, 1, 1.0f, false);
+        write_png((results_dir / fmt::format("images/t6/frame{:03d}.png", i)).string(), display_transform(fr));
+        write_png((results_dir / fmt::format("images/t6/ref{:03d}.png", i)).string(), display_transform(rf));
+    }
+}
+
+// History: 6 older runs; the failing test's accuracy jumped at c4.
+void write_small_run_history(SmallRun& f, const std::string& failing_name) {
+    for (int i = 0; i < 6; ++i) {
+        json h = report::history_entry(f.results);
+        h["commit"] = fmt::format("c{}", i);
+        h["date"] = fmt::format("2026-11-{:02d}T03:00:00Z", 10 + i);
+        h["dirty"] = false;
+        for (auto& [name, v] : h["tests"].items()) {
+            if (v.contains("flip_mean")) v["flip_mean"] = v["flip_mean"].get<double>() * (1 + 0.01 * (i % 2));
+            if (v.contains("frame_ms")) v["frame_ms"] = v["frame_ms"].get<double>() * (1 + 0.02 * (i % 3));
+        }
+        h["tests"][failing_name]["flip_mean"] = i < 4 ? 0.030 : 0.052;
+        h["tests"][failing_name]["verdict"] = i < 4 ? "pass" : "fail";
+        report::append_history(f.root / "history.jsonl", h);
+    }
+    f.history = report::read_history(f.root / "history.jsonl");
+}
 } // namespace
 
 SmallRun& small_run() {
     static SmallRun f = [] {
-        SmallRun f;
-        f.root = fs::temp_directory_path() / ("iblcheck_test_report_" + std::to_string(::getpid()));
-        fs::remove_all(f.root);
-        // Removed when the test process ends (set IBLCHECK_KEEP_TMP=1 to look at the report).
-        static const fs::path cleanup = f.root;
-        if (!std::getenv("IBLCHECK_KEEP_TMP"))
-            std::atexit([] {
-                std::error_code ec;
-                fs::remove_all(cleanup, ec);
-            });
-        f.results_dir = f.root / "run";
-        f.out_dir = f.root / "report";
-        const int W = 192, H = 48;
-
-        json tests = json::array();
+        SmallRun f = small_run_folders();
         // Listed passes first on purpose: the report must put failures first.
-        json t1 = make_test("sampled", "roughness_sweep", "studio", "samples=64", "pass", "t1");
-        t1["accuracy"] = {{"flip_mean", 0.011}, {"golden", "reference/roughness_sweep__studio.exr"}};
-        t1["frame_ms"] = 31.0;
-        t1["frame_ms_samples"] = {24.0, 31.0, 70.0};
-        t1["precompute_ms"] = 4.0;
-        t1["texture_fetches_per_pixel"] = 64;
-        t1["cost"] = {{"spirv_instructions_per_pixel", 54000.0}, {"texture_fetches_per_pixel", 64}};
-        t1["per_sphere"] = per_sphere(0.3);
-        tests.push_back(t1);
-
-        json t2 = make_test("mobile", "roughness_sweep", "studio", "dominant_dir=lagarde", "fail", "t2");
-        t2["message"] = "baseline: flip.mean 0.0123 > 0.0100 (+0.0023); worst 16x16 block at (96,16)";
-        t2["driver_mismatch"] = "golden made with Mesa 22.3.5, this run Mesa 22.3.6";
-        t2["accuracy"] = {{"flip_mean", 0.052}, {"golden", "reference/roughness_sweep__studio.exr"}};
-        t2["frame_ms"] = 3.2;
-        t2["precompute_ms"] = 40.1;
-        t2["texture_fetches_per_pixel"] = 2.5;
-        t2["cost"] = {{"spirv_instructions_per_pixel", 6300.0}, {"texture_fetches_per_pixel", 2.5}};
-        t2["texture_bytes"] = 1048512; // the prefiltered chain, RGBA16F
-        t2["texel_count"] = 131064;
-        t2["per_sphere"] = per_sphere(1.0);
-        t2["stability"] = {{"noise_floor", {{"flip.mean", 0.0004}}}, {"margins", {{"flip.mean", 25.0}}}, {"flaky", false}};
-        t2["comparisons"][0]["approved"] = {{"commit", "c3"},
-                                            {"date", "2026-11-13T03:00:00Z"},
-                                            {"shader_tree_hash", "aaaa"},
-                                            {"driver_info", "Mesa 22.3.5"},
-                                            {"cpu_class", "avx2"}};
-        t2["provenance"] = {{"shader_tree_hash", "bbbb"}};
-        json ref = comparison("reference", "t2", "pass", 0.052);
-        ref["checks"] = json::array({{{"metric", "accuracy.flip.mean"},
-                                      {"value", 0.052},
-                                      {"approved", 0.030},
-                                      {"min", 0.027},
-                                      {"max", 0.033},
-                                      {"status", "fail"},
-                                      {"message", "accuracy.flip.mean 0.052 outside"}}});
-        ref["verdict"] = "fail";
-        t2["comparisons"].push_back(ref);
-        tests.push_back(t2);
-
-        json t3 = make_test("mobile", "roughness_sweep", "studio", "dominant_dir=none", "improved", "t3");
-        t3["accuracy"] = {{"flip_mean", 0.061}};
-        t3["frame_ms"] = 3.0;
-        t3["precompute_ms"] = 38.0;
-        t3["texture_fetches_per_pixel"] = 2.0;
-        t3["cost"] = {{"spirv_instructions_per_pixel", 6200.0}};
-        t3["texture_bytes"] = 62976; // ASTC 6x6
-        tests.push_back(t3);
-
-        json t4 = make_test("mobile", "furnace", "constant", "", "missing-golden", "t4");
-        t4["comparisons"] = json::array(); // no golden: nothing to compare, the rendering alone
-        tests.push_back(t4);
-
-        json t5 = make_test("sampled", "broken", "sky_sun", "", "error", "t5");
-        t5["message"] = "shader compile failed: prefilter.glsl:12: 'foo' : undeclared identifier";
-        t5["comparisons"] = json::array();
-        t5["accuracy"] = nullptr;
-        t5.erase("image");
-        t5.erase("image_exr");
-        tests.push_back(t5);
-
-        json t6 = make_test("mobile", "rotation", "sky_sun", "temporal", "pass", "t6");
-        t6["options"] = json::object();
-        t6["accuracy"] = {{"flip_mean", 0.03}};
-        t6["frame_ms"] = 3.5;
-        t6["precompute_ms"] = 41.0;
-        t6["texture_fetches_per_pixel"] = 2.5;
-        t6["temporal"] = {{"frames", json::array()},
-                          {"reference_frames", json::array()},
-                          {"flicker", 0.01},
-                          {"variation_ratio", 1.3},
-                          {"flip_mean", 0.02}};
-        for (int i = 0; i < 12; ++i) {
-            t6["temporal"]["frames"].push_back(fmt::format("images/t6/frame{:03d}.png", i));
-            t6["temporal"]["reference_frames"].push_back(fmt::format("images/t6/ref{:03d}.png", i));
-        }
-        tests.push_back(t6);
-
-        json t7 = make_test("sampled", "rotation", "sky_sun", "temporal", "pass", "t7");
-        t7["options"] = json::object();
-        t7["accuracy"] = {{"flip_mean", 0.014}};
-        t7["frame_ms"] = 28.0;
-        t7["precompute_ms"] = 3.0;
-        t7["texture_fetches_per_pixel"] = 64;
-        t7["temporal"] = {{"frames", t6["temporal"]["frames"]}, {"flicker", 0.004}, {"flip_mean", 0.012}};
-        tests.push_back(t7);
-
-        json t8 = make_test("mobile", "evil", "studio", "", "pass", "evil");
-        t8["name"] = kEvilName;
-        t8["message"] = "<b>bold</b> & \"quoted\"";
-        t8["accuracy"] = {{"flip_mean", 0.08}};
-        t8["frame_ms"] = 2.0;
-        t8["cost"] = {{"spirv_instructions_per_pixel", 4000.0}};
-        tests.push_back(t8);
-
-        json t9 = make_test("reference", "roughness_sweep", "studio", "", "pass", "t9");
-        t9["comparisons"][0]["images"]["heatmap"] = "images/t9/does_not_exist.png"; // a placeholder, not an error
-        t9["comparisons"][0]["images"].erase("error_exr");
-        t9["frame_ms"] = 5000.0;
-        tests.push_back(t9);
-
-        f.results = {{"schema", "iblcheck-results/1"},
-                     {"suite", "ci"},
-                     {"command", "iblcheck run --suite ci --out report"},
-                     {"started", "2026-11-22T15:40:00Z"},
-                     {"total_s", 41.2},
-                     {"commit", "f554dd9"},
-                     {"dirty", true},
-                     {"cpu_class", "avx2"},
-                     {"driver",
-                      {{"device", "llvmpipe (LLVM 15.0.6, 256 bits)"},
-                       {"driver", "llvmpipe"},
-                       {"driver_info", "Mesa 22.3.6 (LLVM 15.0.6)"},
-                       {"mesa", "22.3.6"},
-                       {"llvm", "15.0.6"},
-                       {"api", "1.3.230"}}},
-                     {"counts", {{"pass", 5}, {"fail", 1}, {"improved", 1}, {"missing-golden", 1}, {"error", 1}}},
-                     {"tests", tests}};
-
-        // Images: linear EXRs and their PNGs, error maps, sphere id maps.
-        for (const char* d : {"t1", "t2", "t3", "t4", "t5", "t6", "t7", "evil", "t9"}) {
-            const cv::Mat test = spheres(W, H, 1, 1.0f, false), base = spheres(W, H, 1, 1.1f, false);
-            write_image(f.results_dir, std::string("images/") + d + "/test.png", test);
-            write_image(f.results_dir, std::string("images/") + d + "/baseline.png", base);
-            write_error(f.results_dir, std::string("images/") + d + "/baseline_flip.png", error_map(test, base));
-            write_image(f.results_dir, std::string("images/") + d + "/reference.png", base);
-            write_error(f.results_dir, std::string("images/") + d + "/reference_flip.png", error_map(test, base));
-            write_png((f.results_dir / "images" / d / "spheres.png").string(), sphere_ids(W, H, 1));
-        }
-        for (int i = 0; i < 12; ++i) {
-            cv::Mat fr = spheres(96, 48, 1, 1.0f + 0.1f * float(i % 3 == 1), false), rf = spheres(96, 48, 1, 1.0f, false);
-            write_png((f.results_dir / fmt::format("images/t6/frame{:03d}.png", i)).string(), display_transform(fr));
-            write_png((f.results_dir / fmt::format("images/t6/ref{:03d}.png", i)).string(), display_transform(rf));
-        }
+        json tests = json::array({sampled_pass_test(), failing_test()});
+        improved_missing_error_tests(tests);
+        temporal_tests(tests);
+        evil_and_reference_tests(tests);
+        f.results = small_run_results(tests);
+        write_small_run_images(f.results_dir);
         std::ofstream(f.results_dir / "results.json") << f.results.dump(2);
-
-        // History: 6 older runs; the failing test's accuracy jumped at c4.
-        for (int i = 0; i < 6; ++i) {
-            json h = report::history_entry(f.results);
-            h["commit"] = fmt::format("c{}", i);
-            h["date"] = fmt::format("2026-11-{:02d}T03:00:00Z", 10 + i);
-            h["dirty"] = false;
-            for (auto& [name, v] : h["tests"].items()) {
-                if (v.contains("flip_mean")) v["flip_mean"] = v["flip_mean"].get<double>() * (1 + 0.01 * (i % 2));
-                if (v.contains("frame_ms")) v["frame_ms"] = v["frame_ms"].get<double>() * (1 + 0.02 * (i % 3));
-            }
-            h["tests"][t2["name"].get<std::string>()]["flip_mean"] = i < 4 ? 0.030 : 0.052;
-            h["tests"][t2["name"].get<std::string>()]["verdict"] = i < 4 ? "pass" : "fail";
-            report::append_history(f.root / "history.jsonl", h);
-        }
-        f.history = report::read_history(f.root / "history.jsonl");
+        write_small_run_history(f, tests[1]["name"].get<std::string>());
         report::write_report(f.results, f.results_dir, f.out_dir, f.history);
         return f;
     }();
     return f;
-}
-
-CiRun make_ci_run(const fs::path& dir, int passing, bool failing) {
-    CiRun run;
-    run.dir = dir;
-    const int W = run.width, H = run.height;
-    fs::create_directories(dir);
-    json tests = json::array();
-    const json spheres_json = sphere_list(W / 48, 2);
-    auto one = [&](int k, bool fail) {
-        const std::string env = k % 2 ? "sky_sun" : "studio";
-        const std::string variant = k == 0 ? "default" : fmt::format("storage=v{}", k);
-        const std::string name = fmt::format("mobile.roughness_sweep.{}.{}", env, variant);
-        const std::string d = "images/" + name + "/";
-        cv::Mat test = spheres(W, H, 2, 1.0f + 0.01f * float(k), env == "sky_sun");
-        cv::Mat base = test.clone();
-        if (fail) { // the baseline differs on metal r=0.5 (index 5): 30 % brighter there
-            const int cx = 24 + 48 * 5, cy = H / 4;
-            for (int y = 0; y < H / 2; ++y)
-                for (int x = cx - 22; x <= cx + 22; ++x)
-                    if ((x - cx) * (x - cx) + (y - cy) * (y - cy) <= 400) base.at<cv::Vec3f>(y, x) *= 1.3f;
-        }
-        const cv::Mat err = error_map(test, base);
-        write_image(dir, d + "test.png", test);
-        write_png((dir / (d + "baseline.png")).string(), display_transform(base));
-        if (fail) write_exr_half((dir / (d + "baseline.exr")).string(), base);
-        write_error(dir, d + "baseline_flip.png", err);
-        write_png((dir / (d + "spheres.png")).string(), sphere_ids(W, H, 2));
-        json imgs = images(name, "baseline");
-        if (!fail) imgs["golden_exr"] = imgs["test_exr"]; // bit-identical: the harness shares the file
-        json t = {{"name", name},
-                  {"suite", "ci"},
-                  {"scene", "roughness_sweep"},
-                  {"method", "mobile"},
-                  {"env", env},
-                  {"variant", variant},
-                  {"options", json::object()},
-                  {"width", W},
-                  {"height", H},
-                  {"verdict", fail ? "fail" : "pass"},
-                  {"image", d + "test.png"},
-                  {"image_exr", d + "test.exr"},
-                  {"layout", {{"id_map", d + "spheres.png"}, {"spheres", spheres_json}}},
-                  {"bless_command", "iblcheck bless --suite 'ci' --filter '" + name + "'"},
-                  {"accuracy", {{"flip_mean", 0.2 + 0.001 * k}}},
-                  {"cost", {{"spirv_instructions_per_pixel", 6276.0 + k}, {"texture_fetches_per_pixel", 2.54}}},
-                  {"frame_ms", 150.0 + k},
-                  {"precompute_ms", 200.0}};
-        double mean = 0;
-        int over = 0;
-        for (int y = 0; y < H; ++y)
-            for (int x = 0; x < W; ++x) {
-                mean += err.at<float>(y, x);
-                over += err.at<float>(y, x) > 0.02f;
-            }
-        mean /= W * H;
-        json cmp = {{"kind", "baseline"},
-                    {"golden", "baseline/" + name + ".exr"},
-                    {"verdict", fail ? "fail" : "pass"},
-                    {"images", imgs},
-                    {"approved",
-                     {{"commit", "da34be9deabf"},
-                      {"date", "2026-11-23T03:15:06Z"},
-                      {"shader_tree_hash", fail ? "d7aa188baa82dc22" : "3f2167d7d4701f9b"},
-                      {"driver_info", "Mesa 22.3.6 (LLVM 15.0.6)"},
-                      {"cpu_class", "avx2-fma-f16c-256"}}},
-                    {"metrics", {{"flip", {{"mean", mean}, {"block_x", 240}, {"block_y", 16}}}}},
-                    {"checks", json::array({{{"metric", "flip.mean"},
-                                             {"value", mean},
-                                             {"min", nullptr},
-                                             {"max", 0.001},
-                                             {"status", fail ? "fail" : "pass"},
-                                             {"message", fmt::format("flip.mean {:.4g} > 0.001", mean)}},
-                                            {{"metric", "flip.p99"},
-                                             {"value", 0.3},
-                                             {"min", nullptr},
-                                             {"max", 0.02},
-                                             {"status", fail ? "fail" : "pass"}}})}};
-        if (fail) cmp["worst_block"] = {{"x", 240}, {"y", 16}, {"flip", 0.26}, {"sphere", "metal r=0.5"}};
-        t["comparisons"] = json::array({cmp});
-        t["provenance"] = {{"shader_tree_hash", "3f2167d7d4701f9b"}};
-        t["message"] = fail ? "baseline: flip.mean > 0.001" : "";
-        tests.push_back(t);
-        if (fail) {
-            run.failing_name = name;
-            run.failing_test = test;
-            run.failing_error = err;
-            run.pixels_over_002 = over;
-        }
-    };
-    if (failing) one(passing, true);
-    for (int k = 0; k < passing; ++k) one(k, false);
-    run.results = {{"schema", "iblcheck-results/1"},
-                   {"suite", "ci"},
-                   {"command", "iblcheck run --suite ci --out report"},
-                   {"started", "2026-11-23T06:12:15Z"},
-                   {"total_s", 27.6},
-                   {"commit", "039aeff2a6fb"},
-                   {"dirty", false},
-                   {"cpu_class", "avx2-fma-f16c-256"},
-                   {"driver",
-                    {{"device", "llvmpipe (LLVM 15.0.6, 256 bits)"},
-                     {"driver_info", "Mesa 22.3.6 (LLVM 15.0.6)"},
-                     {"mesa", "22.3.6"},
-                     {"llvm", "15.0.6"},
-                     {"api", "1.3.230"}}},
-                   {"tests", tests}};
-    std::ofstream(dir / "results.json") << run.results.dump(1);
-    return run;
 }
 
 } // namespace iblcheck::testutil

@@ -1,5 +1,7 @@
-// Synthetic runs for the report's tests (test_report.cpp, test_report_browser.cpp): results JSON
-// plus the files a run writes (PNGs, half-float EXRs, sphere id maps), made without rendering.
+// Synthetic runs for the report's tests (test_report.cpp, test_report_data.cpp,
+// test_report_browser.cpp): results JSON plus the files a run writes (PNGs, half-float EXRs, sphere
+// id maps), made without rendering. small_run() is built in report_fixture.cpp, make_ci_run() in
+// report_ci_fixture.cpp, both from the images of report_fixture_images.h.
 #pragma once
 #include <filesystem>
 #include <string>

@@ -1,6 +1,7 @@
 // The harness (issue 6): suite schema errors, shards, bless/missing-golden/improved/alternate
 // baselines on a private golden folder, JUnit, and the gate: a deliberate shader change makes the
 // `ci` suite fail on exactly the tests it affects, `iblcheck bisect` follows git bisect's contract.
+// Also the per-sphere breakdown of an error map by a render's sphere coverage (image_compare.h).
 #include <gtest/gtest.h>
 
 #include <fmt/format.h>
@@ -15,6 +16,7 @@
 
 #include "harness/common/errors.h"
 #include "harness/golden_store.h"
+#include "harness/image_compare.h"
 #include "harness/runner.h"
 #include "harness/suite.h"
 #include "tests/test_support.h"
@@ -418,4 +420,37 @@ TEST(Temporal, BrokenSpecularAntiAliasingFailsTheGate) {
     EXPECT_NEAR(t["temporal"]["flicker_ratio"].get<double>(), 1.0, 1e-9);
     EXPECT_NE(t["message"].get<std::string>().find("flicker_ratio"), std::string::npos);
     fs::remove_all(dir);
+}
+
+// The per-sphere breakdown reads the render's coverage (RenderResult::coverage): no camera here.
+TEST(ImageCompare, PerSphereErrorsLayoutAndSphereAtReadTheCoverage) {
+    SphereCoverage cov;
+    cov.ids = (cv::Mat_<int>(2, 4) << -1, 0, 0, 1, //
+               -1, 0, 1, 1);
+    cov.spheres = {{"metal r=0.1", 0.1f, 1.0f}, {"dielectric r=0.9", 0.9f, 0.0f}, {"unseen", 0.5f, 0.0f}};
+    const cv::Mat err = (cv::Mat_<float>(2, 4) << 9, 0.1f, 0.2f, 0.4f, //
+                         9, 0.3f, 0.5f, 0.6f);
+    const json ps = per_sphere_errors(cov, err);
+    ASSERT_EQ(ps.size(), 2u); // the background and an unseen sphere are left out
+    EXPECT_EQ(ps[0]["label"], "metal r=0.1");
+    EXPECT_NEAR(ps[0]["flip_mean"].get<double>(), 0.2, 1e-7);
+    EXPECT_EQ(ps[1]["label"], "dielectric r=0.9");
+    EXPECT_NEAR(ps[1]["flip_mean"].get<double>(), 0.5, 1e-7);
+    EXPECT_EQ(ps[1]["roughness"].get<double>(), double(0.9f));
+    EXPECT_EQ(ps[1]["metallic"].get<double>(), 0.0);
+
+    const SphereLayout l = sphere_layout(cov);
+    ASSERT_EQ(l.ids.type(), CV_8U);
+    EXPECT_EQ(l.ids.at<uchar>(0, 0), 0);
+    EXPECT_EQ(l.ids.at<uchar>(0, 1), 1);
+    EXPECT_EQ(l.ids.at<uchar>(1, 3), 2);
+    EXPECT_EQ(l.spheres.size(), 3u);
+    EXPECT_EQ(sphere_at(cov, 0, 1), "");
+    EXPECT_EQ(sphere_at(cov, 2, 1), "dielectric r=0.9");
+
+    SphereCoverage one{cov.ids.clone(), {cov.spheres[0]}};
+    one.ids.setTo(0, one.ids > 0);
+    EXPECT_TRUE(per_sphere_errors(one, err).is_null()); // a single-sphere scene has no breakdown
+    SphereCoverage many{cov.ids, std::vector<SphereCoverage::Sphere>(255, cov.spheres[0])};
+    EXPECT_TRUE(sphere_layout(many).ids.empty()); // more spheres than the 8-bit map holds
 }

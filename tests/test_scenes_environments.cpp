@@ -8,6 +8,7 @@
 
 #include "renderers/environments/environment.h"
 #include "renderers/environments/procedural.h"
+#include "renderers/scenes/coverage.h"
 #include "renderers/scenes/scene.h"
 
 using namespace iblcheck;
@@ -232,6 +233,34 @@ TEST(Scene, NormalsAreUnitOverTheImage) {
                 EXPECT_GT(-(h.normal.x * d.x + h.normal.y * d.y + h.normal.z * d.z), 0.0) << info.name;
             }
         EXPECT_GT(hits, 0) << info.name;
+    }
+}
+
+// A render's coverage (coverage.h) is the sphere the camera ray through each pixel's centre hits first.
+TEST(Scene, CoverageIsTheSphereAtEachPixelCentre) {
+    for (const char* name : {"sphere", "roughness_sweep", "sphere_field"}) {
+        const Scene s = build_scene(name, {});
+        const int w = s.width / 2, h = s.height; // not the scene's aspect: the camera takes the size given
+        const SphereCoverage c = sphere_coverage(s, w, h);
+        ASSERT_EQ(c.ids.type(), CV_32S);
+        ASSERT_EQ(c.ids.cols, w);
+        ASSERT_EQ(c.ids.rows, h);
+        ASSERT_EQ(c.spheres.size(), s.spheres.size());
+        for (size_t i = 0; i < s.spheres.size(); ++i) {
+            EXPECT_EQ(c.spheres[i].label, i < s.labels.size() ? s.labels[i] : "sphere " + std::to_string(i));
+            EXPECT_EQ(c.spheres[i].roughness, s.spheres[i].material.roughness);
+            EXPECT_EQ(c.spheres[i].metallic, s.spheres[i].material.metallic);
+        }
+        int background = 0;
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                Vec3f o, d;
+                camera_ray(s, w, h, x + 0.5, y + 0.5, o, d);
+                const Hit hit = intersect(s, o, d);
+                ASSERT_EQ(c.ids.at<int>(y, x), hit.hit ? hit.sphere : -1) << name << " at " << x << "," << y;
+                background += !hit.hit;
+            }
+        EXPECT_GT(background, 0) << name;
     }
 }
 

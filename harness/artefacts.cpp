@@ -1,0 +1,73 @@
+#include "artefacts.h"
+
+#include <unistd.h>
+
+#include <fmt/core.h>
+
+#include <thread>
+
+#include "golden_store.h"
+#include "image_compare.h"
+#include "metrics/display_transform.h"
+#include "metrics/image_io.h"
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace iblcheck {
+
+Artefacts Artefacts::for_test(const fs::path& out_dir, const std::string& test) {
+    if (out_dir.empty()) return {};
+    return {out_dir / "images" / safe_file_name(test), "images/" + safe_file_name(test) + "/"};
+}
+
+std::string Artefacts::exr(const std::string& png) { return png.substr(0, png.rfind('.')) + ".exr"; }
+
+std::string Artefacts::png(const std::string& name, const cv::Mat& linear, bool with_exr) const {
+    fs::create_directories(dir);
+    write_png((dir / name).string(), display_transform(linear));
+    if (with_exr) write_exr_half((dir / exr(name)).string(), linear);
+    return rel + name;
+}
+
+std::string Artefacts::shared_exr(const std::string& golden_rel, const cv::Mat& linear) const {
+    const fs::path shared = dir.parent_path() / "_goldens";
+    const std::string file = safe_file_name(golden_rel);
+    if (!fs::exists(shared / file)) { // two workers (or processes) may both write it: same pixels, atomic rename
+        fs::create_directories(shared);
+        const fs::path tmp =
+            shared / (file + fmt::format(".tmp{}-{}.exr", ::getpid(), std::hash<std::thread::id>{}(std::this_thread::get_id())));
+        write_exr_half(tmp.string(), linear);
+        fs::rename(tmp, shared / file);
+    }
+    return "images/_goldens/" + file;
+}
+
+std::string Artefacts::heatmap(const std::string& name, const cv::Mat& errmap) const {
+    fs::create_directories(dir);
+    write_png((dir / name).string(), magma_heatmap(errmap));
+    write_exr_half((dir / exr(name)).string(), errmap);
+    return rel + name;
+}
+
+json Artefacts::images(const std::string& test, const std::string& golden, const std::string& heatmap) {
+    return {{"test", test},          {"golden", golden},          {"heatmap", heatmap},
+            {"test_exr", exr(test)}, {"golden_exr", exr(golden)}, {"error_exr", exr(heatmap)}};
+}
+
+json Artefacts::layout(const SphereCoverage& coverage) const {
+    SphereLayout l = sphere_layout(coverage);
+    if (l.ids.empty()) return nullptr;
+    fs::create_directories(dir);
+    cv::Mat ids;
+    l.ids.convertTo(ids, CV_32F, 1.0 / 255.0);
+    write_png((dir / "spheres.png").string(), ids);
+    return {{"id_map", rel + "spheres.png"}, {"spheres", l.spheres}};
+}
+
+void Artefacts::keep_float_render(const cv::Mat& image) const {
+    fs::create_directories(dir);
+    write_exr((dir / "test.exr").string(), image);
+}
+
+} // namespace iblcheck

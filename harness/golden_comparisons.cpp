@@ -1,0 +1,139 @@
+#include "golden_comparisons.h"
+
+#include <fmt/core.h>
+
+#include <algorithm>
+#include <cstring>
+
+#include "bless.h"
+#include "image_compare.h"
+#include "provenance.h"
+
+using nlohmann::json;
+
+namespace iblcheck {
+
+namespace {
+
+// Where the error concentrates, for a person: "worst 16x16 block at (160,16) on metal r=0.3 ...".
+// Recorded on the comparison ({x, y, flip, sphere}); a failing comparison's message says it too.
+// The sphere is the one the render shows at the block's centre (its coverage).
+void note_worst_block(Comparison& c, const SphereCoverage& coverage, const FlipResult& flip) {
+    const int width = coverage.ids.cols, height = coverage.ids.rows;
+    std::string sphere = sphere_at(coverage, std::min(flip.block_x + 8, width - 1), std::min(flip.block_y + 8, height - 1));
+    c.worst_block = {{"x", flip.block_x}, {"y", flip.block_y}, {"flip", flip.block_max}, {"sphere", sphere}};
+    if (c.verdict == Verdict::fail)
+        c.message += fmt::format("; worst 16x16 block at ({},{}){} with mean FLIP {:.4g}", flip.block_x, flip.block_y,
+                                 sphere.empty() ? "" : " on " + sphere, flip.block_max);
+}
+
+BaselineOutcome missing_baseline(const TestCase& tc, const GoldenStore& store) {
+    BaselineOutcome out;
+    out.missing = true;
+    out.comparison.kind = "baseline";
+    out.comparison.verdict = Verdict::missing_golden;
+    out.comparison.message =
+        "no baseline golden at " + store.baseline_path(tc.name).string() + "; create it with: " + bless_command(tc);
+    return out;
+}
+
+// The render against one approved baseline `g`, with its report images.
+Comparison judge_against_baseline(const TestCase& tc, const RenderResult& rr, const Golden& g, const Artefacts& art,
+                                  int flip_threads) {
+    const cv::Mat& image = rr.image;
+    if (g.image.size() != image.size()) return judge_size("baseline", image.cols, image.rows, g.image.cols, g.image.rows);
+    FlipResult flip;
+    Comparison c = judge_baseline(compare_images(g.image, image, flip_threads, &flip), tc.baseline_tolerances);
+    note_worst_block(c, rr.coverage, flip);
+    if (art) {
+        std::string tag = g.label.empty() ? "baseline" : "baseline@" + safe_file_name(g.label);
+        // A render bit-identical to its baseline (the usual pass) shares the test's EXR.
+        const bool same = g.image.type() == image.type() && g.image.isContinuous() && image.isContinuous() &&
+                          std::memcmp(g.image.data, image.data, image.total() * image.elemSize()) == 0;
+        c.images = Artefacts::images(art.rel + "test.png", art.png(tag + ".png", g.image, !same),
+                                     art.heatmap(tag + "_flip.png", flip.errmap));
+        if (same) c.images["golden_exr"] = c.images["test_exr"];
+    }
+    return c;
+}
+
+// One check per cost figure of the render against the figure the baseline approved.
+std::vector<Check> judge_costs(const TestCase& tc, const RenderResult& rr, const Golden& golden) {
+    std::vector<Check> out;
+    const json now = render_cost(rr), approved = golden.provenance.value("cost", json::object());
+    for (auto& [key, value] : now.items()) {
+        if (!approved.contains(key) || !approved[key].is_number()) {
+            Check c{"cost." + key,
+                    value.get<double>(),
+                    {},
+                    {},
+                    {},
+                    Verdict::fail,
+                    "cost." + key + ": the baseline records no approved cost; re-bless it (" + bless_command(tc) + ")"};
+            out.push_back(c);
+            continue;
+        }
+        out.push_back(judge_cost("cost." + key, value.get<double>(), approved[key].get<double>(), tc.max_cost_growth));
+    }
+    return out;
+}
+
+} // namespace
+
+BaselineOutcome judge_against_baselines(const TestCase& tc, const RenderResult& rr, const GoldenStore& store,
+                                        const Artefacts& art, int flip_threads) {
+    std::vector<Golden> goldens = store.baselines(tc.name);
+    if (goldens.empty()) return missing_baseline(tc, store);
+    std::vector<Comparison> candidates;
+    for (const Golden& g : goldens) {
+        Comparison c = judge_against_baseline(tc, rr, g, art, flip_threads);
+        c.golden = store.relative(g.image_path);
+        c.label = g.label;
+        candidates.push_back(std::move(c));
+    }
+    size_t i = choose_baseline(candidates);
+    BaselineOutcome out;
+    out.comparison = std::move(candidates[i]);
+    out.golden = goldens[i];
+    return out;
+}
+
+Comparison cost_comparison(const TestCase& tc, const RenderResult& rr, const BaselineOutcome& base) {
+    Comparison cost;
+    cost.kind = "cost";
+    cost.golden = base.comparison.golden;
+    cost.checks = judge_costs(tc, rr, base.golden);
+    for (const Check& k : cost.checks) {
+        cost.message += k.message.empty() ? "" : (cost.message.empty() ? "" : "; ") + k.message;
+        cost.verdict = overall_verdict({cost.verdict, k.status});
+    }
+    return cost;
+}
+
+Comparison judge_against_truth(const TestCase& tc, const RenderResult& rr, const Golden& ref, const GoldenStore& store,
+                               const json& approved_accuracy, const Artefacts& art, int flip_threads, json& r) {
+    const cv::Mat& image = rr.image;
+    if (ref.image.size() != image.size()) {
+        Comparison c = judge_size("reference", image.cols, image.rows, ref.image.cols, ref.image.rows);
+        c.golden = store.relative(ref.image_path);
+        return c;
+    }
+    FlipResult flip;
+    json metrics = compare_images(ref.image, image, flip_threads, &flip);
+    Comparison c = judge_reference(metrics, approved_accuracy, tc.reference_band);
+    c.golden = store.relative(ref.image_path);
+    note_worst_block(c, rr.coverage, flip);
+    r["accuracy"] = {{"flip_mean", flip.mean},
+                     {"ssim", metrics["ssim"]["mean"]},
+                     {"golden", c.golden},
+                     {"noise_floor", ref.provenance.value("noise_floor", json())}};
+    if (json ps = per_sphere_errors(rr.coverage, flip.errmap); !ps.is_null()) r["per_sphere"] = ps;
+    if (art) {
+        c.images = Artefacts::images(art.rel + "test.png", art.png("reference.png", ref.image, false),
+                                     art.heatmap("reference_flip.png", flip.errmap));
+        c.images["golden_exr"] = art.shared_exr(c.golden, ref.image);
+    }
+    return c;
+}
+
+} // namespace iblcheck

@@ -1,0 +1,38 @@
+// A render against its goldens, each comparison measured (image_compare.h) and judged (verdict.h):
+// the approved baselines (any one may pass the test), the cost recorded with the chosen baseline,
+// and the truth (the reference golden). Each comparison carries its report images when the test
+// writes artefacts, and the worst 16x16 block with the sphere it lies on (the render's coverage).
+#pragma once
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+
+#include "artefacts.h"
+#include "golden_store.h"
+#include "suite.h"
+#include "verdict.h"
+
+namespace iblcheck {
+
+struct BaselineOutcome {
+    Comparison comparison;
+    bool missing = false;
+    Golden golden; // the baseline judged against (empty image when missing)
+};
+
+// Any of the test's approved baselines may pass it; the outcome is the one that did, or the
+// closest one (missing-golden when the test has none).
+BaselineOutcome judge_against_baselines(const TestCase& tc, const RenderResult& rr, const GoldenStore& store,
+                                        const Artefacts& art, int flip_threads);
+
+// The render's cost per pixel against the cost recorded with the chosen baseline, as one
+// comparison of kind "cost". A baseline without a recorded cost cannot gate it: that is a failure
+// to re-bless, not a silent pass.
+Comparison cost_comparison(const TestCase& tc, const RenderResult& rr, const BaselineOutcome& base);
+
+// Accuracy against the reference golden `ref`, judged by the band around the baseline's approved
+// accuracy. Records the test's "accuracy" (and "per_sphere" for multi-sphere scenes) in `r`.
+Comparison judge_against_truth(const TestCase& tc, const RenderResult& rr, const Golden& ref, const GoldenStore& store,
+                               const nlohmann::json& approved_accuracy, const Artefacts& art, int flip_threads,
+                               nlohmann::json& r);
+
+} // namespace iblcheck

@@ -1,0 +1,191 @@
+#include "test_run.h"
+
+#include <algorithm>
+#include <chrono>
+
+#include "artefacts.h"
+#include "bless.h"
+#include "golden_comparisons.h"
+#include "harness/common/errors.h"
+#include "metrics/image_io.h"
+#include "provenance.h"
+#include "stability.h"
+#include "temporal_check.h"
+#include "verdict.h"
+
+using nlohmann::json;
+
+namespace iblcheck {
+
+namespace {
+
+// What the test is, before anything is rendered.
+json test_header(const TestCase& tc) {
+    return {{"name", tc.name},
+            {"suite", tc.suite},
+            {"scene", tc.spec.scene},
+            {"method", tc.spec.method},
+            {"env", tc.spec.env},
+            {"options", tc.spec.options.values()},
+            {"variant", tc.variant},
+            {"tags", tc.tags},
+            {"bless_command", bless_command(tc)},
+            {"comparisons", json::array()},
+            {"accuracy", nullptr},
+            {"driver_mismatch", nullptr}};
+}
+
+void record_render(json& r, const RenderResult& rr) {
+    r["width"] = rr.image.cols;
+    r["height"] = rr.image.rows;
+    double pre = 0, frame = 0;
+    json t = json::array();
+    for (auto& p : rr.timings) {
+        t.push_back({{"pass", p.name}, {"ms", p.ms}, {"gpu", p.gpu}, {"precompute", p.precompute}});
+        (p.precompute ? pre : frame) += p.ms;
+    }
+    r["timings"] = t;
+    r["precompute_ms"] = pre;
+    r["frame_ms"] = frame;
+    r["texture_fetches_per_pixel"] = rr.texture_fetches_per_pixel;
+    if (rr.texture_bytes > 0) { // the bytes/accuracy chart's x (mobile: the prefiltered chain)
+        r["texture_bytes"] = rr.texture_bytes;
+        r["texel_count"] = rr.texel_count;
+    }
+    r["cost"] = render_cost(rr);
+    r["provenance"] = rr.provenance;
+}
+
+// Per-frame time of `repeats` renders in all (the first one already recorded in r): wall times
+// vary 2-5x on a loaded machine, so the results keep every sample and report their median.
+void repeat_timings(json& r, const TestCase& tc, Worker& w, int repeats) {
+    if (repeats < 2) return;
+    std::vector<double> frame{r["frame_ms"].get<double>()};
+    for (int k = 1; k < repeats; ++k) {
+        double f = 0;
+        for (auto& p : w.renderer.render(tc.spec).timings) f += p.precompute ? 0 : p.ms;
+        frame.push_back(f);
+    }
+    std::sort(frame.begin(), frame.end());
+    const size_t n = frame.size();
+    r["frame_ms_samples"] = frame;
+    r["frame_ms"] = n % 2 ? frame[n / 2] : 0.5 * (frame[n / 2 - 1] + frame[n / 2]);
+}
+
+// One test under way: what its checks read, and what they found (the verdicts in order and the
+// messages that say why; the test's verdict is the worst of them).
+struct TestRun {
+    const TestCase& tc;
+    Worker& w;
+    const GoldenStore& store;
+    Artefacts art;
+    int flip_threads;
+    json r; // the results object
+    std::vector<Verdict> verdicts;
+    std::vector<std::string> problems;
+
+    void add(Verdict v, const std::string& message) {
+        verdicts.push_back(v);
+        if (!message.empty()) problems.push_back(message);
+    }
+};
+
+// The render as the report shows it: test.png (+ its EXR) and which sphere is where.
+void record_images(TestRun& t, const RenderResult& rr) {
+    t.r["image"] = t.art.png("test.png", rr.image);
+    t.r["image_exr"] = Artefacts::exr(t.r["image"]);
+    t.r["layout"] = t.art.layout(rr.coverage);
+}
+
+// The approved baselines and, when there is one, the cost approved with it and the platform it was
+// blessed on (a difference is named in the message of a test that does not pass).
+BaselineOutcome check_baselines(TestRun& t, const RenderResult& rr) {
+    BaselineOutcome base = judge_against_baselines(t.tc, rr, t.store, t.art, t.flip_threads);
+    t.r["comparisons"].push_back(to_json(base.comparison));
+    if (base.missing) {
+        t.add(base.comparison.verdict, base.comparison.message);
+        return base;
+    }
+    t.r["comparisons"].back()["approved"] = baseline_facts(base.golden.provenance);
+    t.add(base.comparison.verdict, base.comparison.message.empty() ? "" : "baseline: " + base.comparison.message);
+    const Comparison cost = cost_comparison(t.tc, rr, base);
+    t.r["comparisons"].push_back(to_json(cost));
+    t.add(cost.verdict, cost.message);
+    std::string diff = platform_difference(base.golden.provenance, rr.provenance, this_cpu_class());
+    if (!diff.empty()) t.r["driver_mismatch"] = diff;
+    return base;
+}
+
+// The accuracy the baseline approved (null without one): the bands of the truth and stability checks.
+json approved_accuracy(const BaselineOutcome& base) { return base.golden.provenance.value("accuracy", json()); }
+
+// Against the truth, when the store holds the scene's reference golden; returns its image (empty
+// when there is none).
+cv::Mat check_reference(TestRun& t, const RenderResult& rr, const BaselineOutcome& base) {
+    auto ref = t.store.reference(t.tc.spec);
+    if (!ref) return {};
+    Comparison c = judge_against_truth(t.tc, rr, *ref, t.store, approved_accuracy(base), t.art, t.flip_threads, t.r);
+    t.r["comparisons"].push_back(to_json(c));
+    t.add(c.verdict, c.message.empty() ? "" : "accuracy: " + c.message);
+    return ref->image;
+}
+
+void check_temporal(TestRun& t) {
+    TemporalOutcome o = run_temporal(t.tc, t.w, t.store, t.art.dir, t.art.rel, t.flip_threads);
+    t.r["temporal"] = o.json;
+    for (const Check& k : o.checks) t.add(k.status, k.message.empty() ? "" : "temporal: " + k.message);
+}
+
+void check_stability(TestRun& t, const cv::Mat& image, const cv::Mat& reference, const BaselineOutcome& base) {
+    StabilityOutcome s = run_stability(t.tc, t.w, image, reference, approved_accuracy(base), t.flip_threads);
+    t.r["stability"] = s.json;
+    bool fails = !s.deterministic || (s.flaky && t.tc.stability.fail_on_flaky);
+    t.add(fails ? Verdict::fail : Verdict::pass, s.problem);
+}
+
+// The test's verdict (the worst found) and its message (every problem; the platform difference
+// too when the test did not pass).
+Verdict decide(TestRun& t) {
+    Verdict v = overall_verdict(t.verdicts);
+    t.r["verdict"] = verdict_name(v);
+    std::string msg;
+    for (auto& p : t.problems) msg += (msg.empty() ? "" : "; ") + p;
+    if (t.r["driver_mismatch"].is_string() && v != Verdict::pass)
+        msg += (msg.empty() ? "" : "; ") + t.r["driver_mismatch"].get<std::string>();
+    t.r["message"] = msg;
+    return v;
+}
+
+} // namespace
+
+json run_test(const TestCase& tc, Worker& w, const GoldenStore& store, const std::filesystem::path& out_dir, int flip_threads,
+              int timing_repeats, bool& shader_error) {
+    TestRun t{tc, w, store, Artefacts::for_test(out_dir, tc.name), flip_threads, test_header(tc), {}, {}};
+    const auto t0 = std::chrono::steady_clock::now();
+    cv::Mat image;
+    try {
+        RenderResult rr = w.renderer.render(tc.spec);
+        image = rr.image;
+        record_render(t.r, rr);
+        repeat_timings(t.r, tc, w, timing_repeats);
+        if (NonFinite nf = find_non_finite(rr.image); nf.count) throw NonFiniteRender("render: " + nf.describe());
+        if (t.art) record_images(t, rr);
+        const BaselineOutcome base = tc.baseline ? check_baselines(t, rr) : BaselineOutcome{};
+        const cv::Mat reference = tc.reference ? check_reference(t, rr, base) : cv::Mat();
+        if (tc.temporal.frames > 0) check_temporal(t);
+        if (tc.stability.enabled) check_stability(t, rr.image, reference, base);
+    } catch (const ShaderCompileError& e) {
+        shader_error = true;
+        t.add(Verdict::error, std::string("shader compile failed: ") + e.what());
+    } catch (const NonFiniteRender& e) {
+        t.add(Verdict::fail, e.what());
+    } catch (const std::exception& e) {
+        t.add(Verdict::error, e.what());
+    }
+    // A test that did not pass keeps its render at full precision beside the results.
+    if (decide(t) != Verdict::pass && t.art && !image.empty()) t.art.keep_float_render(image);
+    t.r["wall_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return std::move(t.r);
+}
+
+} // namespace iblcheck
