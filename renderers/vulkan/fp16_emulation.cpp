@@ -262,7 +262,7 @@ void BodyRewriter::round_to_half(uint32_t x, uint32_t type, uint32_t result) {
     uint32_t bt = n == 1 ? boolean : d_.type_decl(spv::OpTypeVector, {boolean, n}, {2});
     auto uc = [&](uint32_t v) { return d_.constant(ut, u32, n, v); };
     auto fc = [&](float f) { return d_.constant(type, t_.half, n, std::bit_cast<uint32_t>(f)); };
-    auto op = [&](spv::Op o, uint32_t ty, std::vector<uint32_t> args, uint32_t id = 0) { return emit(o, ty, args, id); };
+    auto op = [&](spv::Op o, uint32_t ty, const std::vector<uint32_t>& args, uint32_t id = 0) { return emit(o, ty, args, id); };
     uint32_t u = op(spv::OpBitcast, ut, {x});
     uint32_t a = op(spv::OpBitwiseAnd, ut, {u, uc(0x7fffffffu)});
     uint32_t sign = op(spv::OpBitwiseAnd, ut, {u, uc(0x80000000u)});

@@ -178,7 +178,10 @@ std::string cache_key(const fs::path& path, Stage stage, const Defines& defines,
     h.update(std::string(stage.key) + ";glslang-vulkan1.2;");
     std::set<fs::path> seen;
     hash_sources(path, h, seen);
-    for (const auto& [k, v] : defines) h.update(k + "=" + v + ";");
+    for (const auto& [k, v] : defines) {
+        std::string entry = k;
+        h.update(entry.append("=").append(v).append(";"));
+    }
     if (options.count_instructions) h.update("count_instructions=" + std::to_string(kCostPassVersion) + ";");
     if (options.emulate_fp16) h.update("pass:fp16-emulation:" IBLCHECK_FP16_PASS_HASH ";");
     return h.hex();
@@ -186,7 +189,7 @@ std::string cache_key(const fs::path& path, Stage stage, const Defines& defines,
 
 std::string preamble_of(const Defines& defines) {
     std::string preamble = "#extension GL_GOOGLE_include_directive : require\n";
-    for (const auto& [k, v] : defines) preamble += "#define " + k + " " + v + "\n";
+    for (const auto& [k, v] : defines) preamble.append("#define ").append(k).append(" ").append(v).append("\n");
     return preamble;
 }
 
