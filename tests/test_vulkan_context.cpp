@@ -1,6 +1,7 @@
 // The Vulkan plumbing on lavapipe: a compute shader checked value by value (with validation on and
 // no validation error allowed), fp16 arithmetic as the driver does it, the run-time compiler's
-// include/define/cache behaviour and its error path, and `iblcheck doctor` without a driver.
+// include/define/cache behaviour (a damaged cache entry included) and its error path, and
+// `iblcheck doctor` without a driver.
 #include <gtest/gtest.h>
 
 #include <array>
@@ -129,6 +130,24 @@ TEST(ShaderCompiler, ErrorNamesFileAndLine) {
         EXPECT_NE(msg.find("bad.comp:4:"), std::string::npos) << msg;
         EXPECT_NE(msg.find("undefined_thing"), std::string::npos) << msg;
     }
+    fs::remove_all(dir);
+}
+
+TEST(ShaderCompiler, ACacheFileThatIsNotSpirvIsCompiledAgain) {
+    // A cache entry of whole words without the SPIR-V magic number (damaged, or written by
+    // something else) is ignored, and the module compiled instead is glslang's alone: before
+    // compile_stage_file was split (issue 19), glslang appended it to the damaged words.
+    fs::path dir = temp_dir("badcache");
+    setenv("IBLCHECK_CACHE_DIR", (dir / "cache").c_str(), 1);
+    write_file(dir / "one.comp", "#version 460\nlayout(local_size_x = 1) in;\nvoid main() {}\n");
+    auto fresh = vk::compile_compute_shader_file(dir / "one.comp");
+    fs::path cached = vk::spirv_cache_dir() / (fresh.source_hash + ".spv");
+    ASSERT_TRUE(fs::exists(cached));
+    write_file(cached, std::string(64, 'x'));
+    auto again = vk::compile_compute_shader_file(dir / "one.comp");
+    EXPECT_FALSE(again.from_cache);
+    EXPECT_EQ(again.spirv, fresh.spirv);
+    EXPECT_EQ(vk::validate_spirv(again.spirv), "");
     fs::remove_all(dir);
 }
 

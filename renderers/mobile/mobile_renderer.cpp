@@ -15,51 +15,58 @@
 
 namespace iblcheck {
 
-RenderResult render_mobile(GpuSession& gpu, const Environment& env, const TestSpec& spec) {
-    const OptionMap& o = spec.options;
-    int width = 0, height = 0;
-    Scene scene = scene_for(spec, width, height);
+namespace {
 
+// What a mobile render reads from its options before any GPU work, in the order it reads them
+// (so the first invalid option is the one reported).
+struct MobileOptions {
     PrecomputeSettings ps;
+    std::map<std::string, std::string> variant; // the shader selections (option table)
+    std::string fp16;
+};
+
+MobileOptions read_mobile_options(const OptionMap& o) {
+    MobileOptions m;
+    PrecomputeSettings& ps = m.ps;
     ps.cube_size = uint32_t(o.get_int("cube_size", 128));
     ps.mips = uint32_t(o.get_int("mips", 7));
     ps.prefilter_samples = uint32_t(o.get_int("prefilter_samples", 64));
-    const std::map<std::string, std::string> variant = shader_selections(o, "mobile");
-    ps.mip_mapping = variant.at("mip_mapping");
-    ps.storage = variant.at("storage");
+    m.variant = shader_selections(o, "mobile");
+    ps.mip_mapping = m.variant.at("mip_mapping");
+    ps.storage = m.variant.at("storage");
     ps.astc_block = option_choice(o, "astc_block");
-    ps.env_layout = variant.at("env_layout");
+    ps.env_layout = m.variant.at("env_layout");
     ps.rgbm_range = float(o.get_double("rgbm_range", 6.0));
-    ps.lut = variant.at("env_brdf") == "lut";
+    ps.lut = m.variant.at("env_brdf") == "lut";
     ps.lut_size = uint32_t(o.get_int("lut_size", 64));
-    ps.irradiance_cube = variant.at("diffuse") == "irradiance_cube";
+    ps.irradiance_cube = m.variant.at("diffuse") == "irradiance_cube";
     ps.env_rotation_deg = float(o.get_double("env_rotation", 0.0));
     if (ps.prefilter_samples < 1 || ps.prefilter_samples > 65536)
         throw UsageError("option 'prefilter_samples' must be in 1..65536");
-    std::string fp16 = option_choice(o, "fp16");
-    // precision=mediump computes in float16_t: natively, or emulated where the device lacks
-    // shaderFloat16 (or fp16=emulated asks for it). One rule, shared with `iblcheck doctor`.
-    std::optional<vk::Fp16Path> fp16_path;
-    if (variant.at("precision") == "mediump")
-        fp16_path = vk::choose_fp16_path(fp16, gpu.ctx().info().shader_float16, gpu.ctx().info().device_name);
-    vk::CompileOptions shade_options;
-    shade_options.emulate_fp16 = fp16_path == vk::Fp16Path::emulated;
+    m.fp16 = option_choice(o, "fp16");
+    return m;
+}
 
-    RenderResult result;
-    bool cached = false;
-    auto ibl_ptr = precompute_cached(gpu, env, ps, result.timings, cached);
-    const IblResources& ibl = *ibl_ptr;
+// precision=mediump computes in float16_t: natively, or emulated where the device lacks
+// shaderFloat16 (or fp16=emulated asks for it). One rule, shared with `iblcheck doctor`.
+std::optional<vk::Fp16Path> fp16_path_of(GpuSession& gpu, const MobileOptions& m) {
+    if (m.variant.at("precision") != "mediump") return std::nullopt;
+    return vk::choose_fp16_path(m.fp16, gpu.ctx().info().shader_float16, gpu.ctx().info().device_name);
+}
 
-    vk::Defines defs = storage_defines(ps, ibl.native_r11g11b10);
-    defs.merge(glsl_defines(variant)); // keeps storage_defines' entries; adds the other selections
-    const bool fragment = variant.at("shading") == "fragment";
-    if (scene_uses_ao(scene)) defs["MATERIAL_AO"] = "1"; // scene.glsl: each sphere carries its AO
+// The shading pass's defines: the storage's, the other selections', and per-sphere AO where the
+// scene has it (scene.glsl).
+vk::Defines shading_defines(const MobileOptions& m, const IblResources& ibl, const Scene& scene) {
+    vk::Defines defs = storage_defines(m.ps, ibl.native_r11g11b10);
+    defs.merge(glsl_defines(m.variant)); // keeps storage_defines' entries; adds the other selections
+    if (scene_uses_ao(scene)) defs["MATERIAL_AO"] = "1";
+    return defs;
+}
 
-    vk::Context& ctx = gpu.ctx();
-    vk::Buffer scene_buf = upload_scene(ctx, scene);
+// ssaa: rays per pixel (compute) or the supersampling factor (fragment, default 1: a phone
+// renders at its resolution and relies on MSAA at silhouettes).
+ShadePush shade_push(const OptionMap& o, int width, int height, const PrecomputeSettings& ps, const IblResources& ibl) {
     std::string indirect = o.get_string("indirect_irradiance", "sh9");
-    // ssaa: rays per pixel (compute) or the supersampling factor (fragment, default 1: a phone
-    // renders at its resolution and relies on MSAA at silhouettes).
     ShadePush pc{uint32_t(width),
                  uint32_t(height),
                  uint32_t(ssaa_of(o)),
@@ -74,66 +81,126 @@ RenderResult render_mobile(GpuSession& gpu, const Environment& env, const TestSp
                  ps.env_rotation_deg};
     if (pc.ssaa < 1 || pc.ssaa > 16) throw UsageError("option 'ssaa' must be in 1..16");
     if (pc.mix_end <= pc.mix_begin) throw UsageError("option 'mix_end_roughness' must exceed 'mix_begin_roughness'");
+    return pc;
+}
 
-    std::vector<vk::Binding> b = {vk::Binding::storage_buffer(0, scene_buf),
-                                  vk::Binding::sampled_image(1, ibl.prefiltered.sampled_view, ctx.linear_sampler()),
-                                  vk::Binding::storage_buffer(2, ibl.sh),
-                                  vk::Binding::sampled_image(3, ibl.lut.sampled_view, ctx.linear_sampler()),
-                                  vk::Binding::sampled_image(4, ibl.irradiance.sampled_view, ctx.linear_sampler())};
-    // Texture samples per shading: one prefiltered-cube read (two for a 2D layout, one per level:
-    // env_layout.glsl; a second read at n for normalization=directional), plus the LUT and the
-    // irradiance cube when used (SH9 is arithmetic).
-    const double env_reads = (variant.at("normalization") == "directional" ? 2.0 : 1.0) * (ps.env_layout == "cube" ? 1.0 : 2.0);
-    const double per_hit = env_reads + (ps.lut ? 1.0 : 0.0) + (ps.irradiance_cube ? 1.0 : 0.0);
-    std::optional<double> instructions;
-    if (fragment) {
-        FragmentShadingResult f = shade_fragment(gpu, {defs, shade_options, b, pc, uint32_t(scene.spheres.size())});
-        result.image = f.image;
-        result.timings.insert(result.timings.end(), f.timings.begin(), f.timings.end());
-        result.texture_fetches_per_pixel = f.shaded_fragments_per_pixel * per_hit;
-        instructions = f.instructions_per_pixel;
-    } else {
-        const std::vector<VkDescriptorType> types = {kStorageBuffer, kSampled, kStorageBuffer,
-                                                     kSampled,       kSampled, kStorageBuffer};
-        const auto& shade = gpu.pipeline("shade_spheres.comp", defs, types, sizeof(ShadePush), shade_options);
-        vk::Buffer out = ctx.create_buffer(VkDeviceSize(width) * height * 16);
-        b.push_back(vk::Binding::storage_buffer(5, out));
-        vk::GpuTimer timer(ctx, 1);
-        ctx.submit([&](VkCommandBuffer cmd) {
-            timer.reset(cmd);
-            shade.warm_up(cmd, b, &pc, sizeof pc);
-            timer.begin(cmd, "shade_spheres");
-            shade.dispatch(cmd, b, &pc, sizeof pc, (width + 7) / 8, (height + 7) / 8, 1);
-            timer.end(cmd);
-            ctx.barrier(cmd);
-        });
-        for (auto& [name, ms] : timer.results()) result.timings.push_back({name, ms, true, false});
-        double coverage = read_back_image(out, width, height, result.image);
-        // One shading per ray that hits.
-        result.texture_fetches_per_pixel = coverage * pc.ssaa * pc.ssaa * per_hit;
-        instructions = shading_instructions_per_pixel(
-            gpu, {"shade_spheres.comp", defs, types, shade_options, b, 5, &pc, sizeof pc, width, height}, out);
-    }
+// Bindings 0..4 of both shading paths: the spheres, the prefiltered chain, SH9, the LUT and the
+// irradiance cube (compute adds its output image at 5).
+std::vector<vk::Binding> shading_bindings(vk::Context& ctx, const vk::Buffer& scene_buf, const IblResources& ibl) {
+    return {vk::Binding::storage_buffer(0, scene_buf),
+            vk::Binding::sampled_image(1, ibl.prefiltered.sampled_view, ctx.linear_sampler()),
+            vk::Binding::storage_buffer(2, ibl.sh), vk::Binding::sampled_image(3, ibl.lut.sampled_view, ctx.linear_sampler()),
+            vk::Binding::sampled_image(4, ibl.irradiance.sampled_view, ctx.linear_sampler())};
+}
+
+// Texture samples per shading: one prefiltered-cube read (two for a 2D layout, one per level:
+// env_layout.glsl; a second read at n for normalization=directional), plus the LUT and the
+// irradiance cube when used (SH9 is arithmetic).
+double texture_samples_per_hit(const MobileOptions& m) {
+    const double env_reads =
+        (m.variant.at("normalization") == "directional" ? 2.0 : 1.0) * (m.ps.env_layout == "cube" ? 1.0 : 2.0);
+    return env_reads + (m.ps.lut ? 1.0 : 0.0) + (m.ps.irradiance_cube ? 1.0 : 0.0);
+}
+
+// What both shading paths draw with.
+struct ShadingInputs {
+    vk::Defines defines;
+    vk::CompileOptions options; // fp16 emulation
+    std::vector<vk::Binding> bindings;
+    ShadePush push;
+    uint32_t sphere_count;
+    double per_hit; // texture samples per shading
+};
+
+// shading=fragment into `result` (image, timings, texture fetches); returns its instruction count.
+std::optional<double> shade_with_fragments(GpuSession& gpu, const ShadingInputs& in, RenderResult& result) {
+    FragmentShadingResult f = shade_fragment(gpu, {in.defines, in.options, in.bindings, in.push, in.sphere_count});
+    result.image = f.image;
+    result.timings.insert(result.timings.end(), f.timings.begin(), f.timings.end());
+    result.texture_fetches_per_pixel = f.shaded_fragments_per_pixel * in.per_hit;
+    return f.instructions_per_pixel;
+}
+
+// shading=compute into `result` (image, timings, texture fetches); returns its instruction count.
+std::optional<double> shade_with_compute(GpuSession& gpu, const ShadingInputs& in, RenderResult& result) {
+    vk::Context& ctx = gpu.ctx();
+    const int width = int(in.push.width), height = int(in.push.height);
+    const std::vector<VkDescriptorType> types = {kStorageBuffer, kSampled, kStorageBuffer, kSampled, kSampled, kStorageBuffer};
+    const auto& shade = gpu.pipeline("shade_spheres.comp", in.defines, types, sizeof(ShadePush), in.options);
+    vk::Buffer out = ctx.create_buffer(VkDeviceSize(width) * height * 16);
+    std::vector<vk::Binding> b = in.bindings;
+    b.push_back(vk::Binding::storage_buffer(5, out));
+    const ShadePush& pc = in.push;
+    vk::GpuTimer timer(ctx, 1);
+    ctx.submit([&](VkCommandBuffer cmd) {
+        timer.reset(cmd);
+        shade.warm_up(cmd, b, &pc, sizeof pc);
+        timer.begin(cmd, "shade_spheres");
+        shade.dispatch(cmd, b, &pc, sizeof pc, (width + 7) / 8, (height + 7) / 8, 1);
+        timer.end(cmd);
+        ctx.barrier(cmd);
+    });
+    for (auto& [name, ms] : timer.results()) result.timings.push_back({name, ms, true, false});
+    double coverage = read_back_image(out, width, height, result.image);
+    // One shading per ray that hits.
+    result.texture_fetches_per_pixel = coverage * pc.ssaa * pc.ssaa * in.per_hit;
+    return shading_instructions_per_pixel(
+        gpu, {"shade_spheres.comp", in.defines, types, in.options, b, 5, &pc, sizeof pc, width, height}, out);
+}
+
+nlohmann::json mobile_provenance(const MobileOptions& m, const IblResources& ibl, bool cached, std::optional<double> instructions,
+                                 double texture_fetches_per_pixel) {
+    const PrecomputeSettings& ps = m.ps;
+    return {{"method", "mobile"},
+            {"cost", cost_provenance(instructions, texture_fetches_per_pixel)},
+            {"precompute_cached", cached},
+            {"cube_size", ps.cube_size},
+            {"mips", std::min(ps.mips, ibl.full_mips)},
+            {"storage_native", ps.storage != "r11g11b10" || ibl.native_r11g11b10},
+            {"texture", {{"layout", ps.env_layout}, {"texels", ibl.texel_count}, {"bytes", ibl.texture_bytes}}},
+            {"shader_variant", glsl_selection_names(m.variant)}};
+}
+
+// What the cost counts differs from compute's: renderers/mobile/fragment_shading.h.
+nlohmann::json fragment_provenance(const ShadingInputs& in, double texture_fetches_per_pixel) {
+    return {{"msaa_samples", 4},
+            {"ssaa", in.push.ssaa},
+            {"shaded_fragments_per_pixel", texture_fetches_per_pixel / in.per_hit},
+            {"instructions_counted", "vertex and fragment invocations; helper invocations excluded"}};
+}
+
+} // namespace
+
+RenderResult render_mobile(GpuSession& gpu, const Environment& env, const TestSpec& spec) {
+    const OptionMap& o = spec.options;
+    int width = 0, height = 0;
+    Scene scene = scene_for(spec, width, height);
+    const MobileOptions m = read_mobile_options(o);
+    const std::optional<vk::Fp16Path> fp16_path = fp16_path_of(gpu, m);
+
+    RenderResult result;
+    bool cached = false;
+    auto ibl_ptr = precompute_cached(gpu, env, m.ps, result.timings, cached);
+    const IblResources& ibl = *ibl_ptr;
+
+    ShadingInputs in;
+    in.defines = shading_defines(m, ibl, scene);
+    in.options.emulate_fp16 = fp16_path == vk::Fp16Path::emulated;
+    vk::Context& ctx = gpu.ctx();
+    vk::Buffer scene_buf = upload_scene(ctx, scene);
+    in.push = shade_push(o, width, height, m.ps, ibl);
+    in.bindings = shading_bindings(ctx, scene_buf, ibl);
+    in.sphere_count = uint32_t(scene.spheres.size());
+    in.per_hit = texture_samples_per_hit(m);
+
+    const bool fragment = m.variant.at("shading") == "fragment";
+    std::optional<double> instructions = fragment ? shade_with_fragments(gpu, in, result) : shade_with_compute(gpu, in, result);
     result.shader_instructions_per_pixel = instructions.value_or(0);
     result.texel_count = ibl.texel_count;
     result.texture_bytes = ibl.texture_bytes;
-    result.provenance = {{"method", "mobile"},
-                         {"cost", cost_provenance(instructions, result.texture_fetches_per_pixel)},
-                         {"precompute_cached", cached},
-                         {"cube_size", ps.cube_size},
-                         {"mips", std::min(ps.mips, ibl.full_mips)},
-                         {"storage_native", ps.storage != "r11g11b10" || ibl.native_r11g11b10},
-                         {"texture", {{"layout", ps.env_layout}, {"texels", ibl.texel_count}, {"bytes", ibl.texture_bytes}}},
-                         {"shader_variant", glsl_selection_names(variant)}};
+    result.provenance = mobile_provenance(m, ibl, cached, instructions, result.texture_fetches_per_pixel);
     if (fp16_path) result.provenance["fp16"] = vk::fp16_path_name(*fp16_path);
-    if (fragment) {
-        // What the cost counts differs from compute's: renderers/mobile/fragment_shading.h.
-        result.provenance["fragment"] = {
-            {"msaa_samples", 4},
-            {"ssaa", pc.ssaa},
-            {"shaded_fragments_per_pixel", result.texture_fetches_per_pixel / per_hit},
-            {"instructions_counted", "vertex and fragment invocations; helper invocations excluded"}};
-    }
+    if (fragment) result.provenance["fragment"] = fragment_provenance(in, result.texture_fetches_per_pixel);
     return result;
 }
 

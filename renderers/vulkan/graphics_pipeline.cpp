@@ -80,6 +80,138 @@ uint32_t texel_bytes(VkFormat f) {
     }
 }
 
+// Binding i of type bindings[i] in both stages, and the instruction counter's when `counts`.
+std::vector<VkDescriptorSetLayoutBinding> layout_bindings(const std::vector<VkDescriptorType>& bindings, bool counts) {
+    std::vector<VkDescriptorSetLayoutBinding> lb;
+    for (uint32_t i = 0; i < bindings.size(); ++i) lb.push_back({i, bindings[i], 1, kStages, nullptr});
+    if (counts && bindings.size() > kCostBinding)
+        throw Error("GraphicsPipeline: binding " + std::to_string(kCostBinding) + " is the instruction counter's");
+    if (counts) lb.push_back({kCostBinding, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, kStages, nullptr});
+    return lb;
+}
+
+VkDescriptorSetLayout create_set_layout(VkDevice dev, const std::vector<VkDescriptorSetLayoutBinding>& bindings) {
+    auto dl = vk_struct<VkDescriptorSetLayoutCreateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO);
+    dl.flags = VK_DESCRIPTOR_SET_LAYOUT_CREATE_PUSH_DESCRIPTOR_BIT_KHR;
+    dl.bindingCount = uint32_t(bindings.size());
+    dl.pBindings = bindings.data();
+    VkDescriptorSetLayout layout = VK_NULL_HANDLE;
+    check(vkCreateDescriptorSetLayout(dev, &dl, nullptr, &layout), "vkCreateDescriptorSetLayout");
+    return layout;
+}
+
+// Set 0 and, when `push_constant_bytes` > 0, one push-constant range both stages see.
+VkPipelineLayout create_pipeline_layout(VkDevice dev, VkDescriptorSetLayout set_layout, uint32_t push_constant_bytes) {
+    VkPushConstantRange pcr{kStages, 0, push_constant_bytes};
+    auto pl = vk_struct<VkPipelineLayoutCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO);
+    pl.setLayoutCount = 1;
+    pl.pSetLayouts = &set_layout;
+    pl.pushConstantRangeCount = push_constant_bytes ? 1 : 0;
+    pl.pPushConstantRanges = &pcr;
+    VkPipelineLayout layout = VK_NULL_HANDLE;
+    check(vkCreatePipelineLayout(dev, &pl, nullptr, &layout), "vkCreatePipelineLayout");
+    return layout;
+}
+
+// The vertex and fragment shader modules, destroyed with this object.
+class StageModules {
+  public:
+    explicit StageModules(VkDevice dev) : dev_(dev) {}
+    ~StageModules() {
+        for (VkShaderModule m : modules_)
+            if (m) vkDestroyShaderModule(dev_, m, nullptr);
+    }
+    StageModules(const StageModules&) = delete;
+    StageModules& operator=(const StageModules&) = delete;
+
+    // The module of `stage` (vertex or fragment) made from `shader`, as a pipeline stage.
+    VkPipelineShaderStageCreateInfo create(VkShaderStageFlagBits stage, const CompiledShader& shader) {
+        VkShaderModule& module = modules_[stage == VK_SHADER_STAGE_VERTEX_BIT ? 0 : 1];
+        auto smi = vk_struct<VkShaderModuleCreateInfo>(VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO);
+        smi.codeSize = shader.spirv.size() * 4;
+        smi.pCode = shader.spirv.data();
+        check(vkCreateShaderModule(dev_, &smi, nullptr, &module), "vkCreateShaderModule");
+        auto info = vk_struct<VkPipelineShaderStageCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO);
+        info.stage = stage;
+        info.module = module;
+        info.pName = "main";
+        return info;
+    }
+
+  private:
+    VkDevice dev_;
+    VkShaderModule modules_[2] = {VK_NULL_HANDLE, VK_NULL_HANDLE};
+};
+
+// The fixed-function state of every pipeline here: no vertex buffers, no culling, MSAA without
+// sample shading, an optional depth test (less, with writes), no blending, dynamic viewport and
+// scissor. It points into itself, hence neither copied nor moved.
+struct FixedFunctionState {
+    explicit FixedFunctionState(const GraphicsPipelineDesc& d) {
+        ia.topology = d.topology;
+        vp.viewportCount = 1;
+        vp.scissorCount = 1;
+        rs.polygonMode = VK_POLYGON_MODE_FILL;
+        rs.cullMode = VK_CULL_MODE_NONE;
+        rs.frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE;
+        rs.lineWidth = 1.0f;
+        ms.rasterizationSamples = d.target.samples;
+        ms.sampleShadingEnable = VK_FALSE; // MSAA: one shading per pixel, coverage per sample
+        ds.depthTestEnable = d.depth_test;
+        ds.depthWriteEnable = d.depth_test;
+        ds.depthCompareOp = VK_COMPARE_OP_LESS;
+        blend.colorWriteMask =
+            VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT | VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT;
+        cb.attachmentCount = 1;
+        cb.pAttachments = &blend;
+        dy.dynamicStateCount = 2;
+        dy.pDynamicStates = dyn;
+    }
+    FixedFunctionState(const FixedFunctionState&) = delete;
+    FixedFunctionState& operator=(const FixedFunctionState&) = delete;
+
+    VkPipelineVertexInputStateCreateInfo vi =
+        vk_struct<VkPipelineVertexInputStateCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO);
+    VkPipelineInputAssemblyStateCreateInfo ia =
+        vk_struct<VkPipelineInputAssemblyStateCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO);
+    VkPipelineViewportStateCreateInfo vp =
+        vk_struct<VkPipelineViewportStateCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO);
+    VkPipelineRasterizationStateCreateInfo rs =
+        vk_struct<VkPipelineRasterizationStateCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO);
+    VkPipelineMultisampleStateCreateInfo ms =
+        vk_struct<VkPipelineMultisampleStateCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO);
+    VkPipelineDepthStencilStateCreateInfo ds =
+        vk_struct<VkPipelineDepthStencilStateCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO);
+    VkPipelineColorBlendAttachmentState blend{};
+    VkPipelineColorBlendStateCreateInfo cb =
+        vk_struct<VkPipelineColorBlendStateCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO);
+    VkDynamicState dyn[2] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
+    VkPipelineDynamicStateCreateInfo dy =
+        vk_struct<VkPipelineDynamicStateCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO);
+};
+
+VkPipeline create_pipeline(VkDevice dev, const GraphicsPipelineDesc& d, const VkPipelineShaderStageCreateInfo (&stages)[2],
+                           VkPipelineLayout layout, VkRenderPass render_pass) {
+    const FixedFunctionState f(d);
+    auto ci = vk_struct<VkGraphicsPipelineCreateInfo>(VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO);
+    ci.stageCount = 2;
+    ci.pStages = stages;
+    ci.pVertexInputState = &f.vi;
+    ci.pInputAssemblyState = &f.ia;
+    ci.pViewportState = &f.vp;
+    ci.pRasterizationState = &f.rs;
+    ci.pMultisampleState = &f.ms;
+    ci.pDepthStencilState = &f.ds;
+    ci.pColorBlendState = &f.cb;
+    ci.pDynamicState = &f.dy;
+    ci.layout = layout;
+    ci.renderPass = render_pass;
+    ci.subpass = 0;
+    VkPipeline pipeline = VK_NULL_HANDLE;
+    check(vkCreateGraphicsPipelines(dev, VK_NULL_HANDLE, 1, &ci, nullptr, &pipeline), "vkCreateGraphicsPipelines");
+    return pipeline;
+}
+
 } // namespace
 
 void require_target_support(const Context& ctx, const TargetFormat& format) {
@@ -217,89 +349,19 @@ GraphicsPipeline::GraphicsPipeline(Context& ctx, const GraphicsPipelineDesc& d) 
         throw EnvironmentError(
             ctx.info().device_name +
             ": counting a draw's instructions needs vertexPipelineStoresAndAtomics and fragmentStoresAndAtomics");
-    std::vector<VkDescriptorSetLayoutBinding> lb;
-    for (uint32_t i = 0; i < d.bindings.size(); ++i) lb.push_back({i, d.bindings[i], 1, kStages, nullptr});
-    if (counts_ && d.bindings.size() > kCostBinding)
-        throw Error("GraphicsPipeline: binding " + std::to_string(kCostBinding) + " is the instruction counter's");
-    if (counts_) lb.push_back({kCostBinding, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, kStages, nullptr});
-    auto dl = vk_struct<VkDescriptorSetLayoutCreateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO);
-    dl.flags = VK_DESCRIPTOR_SET_LAYOUT_CREATE_PUSH_DESCRIPTOR_BIT_KHR;
-    dl.bindingCount = uint32_t(lb.size());
-    dl.pBindings = lb.data();
-    VkShaderModule modules[2] = {VK_NULL_HANDLE, VK_NULL_HANDLE};
+    const std::vector<VkDescriptorSetLayoutBinding> bindings = layout_bindings(d.bindings, counts_);
     try {
-        check(vkCreateDescriptorSetLayout(dev, &dl, nullptr, &set_layout_), "vkCreateDescriptorSetLayout");
-        VkPushConstantRange pcr{kStages, 0, d.push_constant_bytes};
-        auto pl = vk_struct<VkPipelineLayoutCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO);
-        pl.setLayoutCount = 1;
-        pl.pSetLayouts = &set_layout_;
-        pl.pushConstantRangeCount = d.push_constant_bytes ? 1 : 0;
-        pl.pPushConstantRanges = &pcr;
-        check(vkCreatePipelineLayout(dev, &pl, nullptr, &layout_), "vkCreatePipelineLayout");
+        set_layout_ = create_set_layout(dev, bindings);
+        layout_ = create_pipeline_layout(dev, set_layout_, d.push_constant_bytes);
         render_pass_ = create_render_pass(dev, d.target);
-
-        const CompiledShader* shaders[2] = {d.vertex, d.fragment};
-        VkPipelineShaderStageCreateInfo stages[2];
-        for (int i = 0; i < 2; ++i) {
-            auto smi = vk_struct<VkShaderModuleCreateInfo>(VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO);
-            smi.codeSize = shaders[i]->spirv.size() * 4;
-            smi.pCode = shaders[i]->spirv.data();
-            check(vkCreateShaderModule(dev, &smi, nullptr, &modules[i]), "vkCreateShaderModule");
-            stages[i] = vk_struct<VkPipelineShaderStageCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO);
-            stages[i].stage = i == 0 ? VK_SHADER_STAGE_VERTEX_BIT : VK_SHADER_STAGE_FRAGMENT_BIT;
-            stages[i].module = modules[i];
-            stages[i].pName = "main";
-        }
-        auto vi = vk_struct<VkPipelineVertexInputStateCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO);
-        auto ia = vk_struct<VkPipelineInputAssemblyStateCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO);
-        ia.topology = d.topology;
-        auto vp = vk_struct<VkPipelineViewportStateCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO);
-        vp.viewportCount = 1;
-        vp.scissorCount = 1;
-        auto rs = vk_struct<VkPipelineRasterizationStateCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO);
-        rs.polygonMode = VK_POLYGON_MODE_FILL;
-        rs.cullMode = VK_CULL_MODE_NONE;
-        rs.frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE;
-        rs.lineWidth = 1.0f;
-        auto ms = vk_struct<VkPipelineMultisampleStateCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO);
-        ms.rasterizationSamples = d.target.samples;
-        ms.sampleShadingEnable = VK_FALSE; // MSAA: one shading per pixel, coverage per sample
-        auto ds = vk_struct<VkPipelineDepthStencilStateCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO);
-        ds.depthTestEnable = d.depth_test;
-        ds.depthWriteEnable = d.depth_test;
-        ds.depthCompareOp = VK_COMPARE_OP_LESS;
-        VkPipelineColorBlendAttachmentState blend{};
-        blend.colorWriteMask =
-            VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT | VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT;
-        auto cb = vk_struct<VkPipelineColorBlendStateCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO);
-        cb.attachmentCount = 1;
-        cb.pAttachments = &blend;
-        VkDynamicState dyn[2] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
-        auto dy = vk_struct<VkPipelineDynamicStateCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO);
-        dy.dynamicStateCount = 2;
-        dy.pDynamicStates = dyn;
-        auto ci = vk_struct<VkGraphicsPipelineCreateInfo>(VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO);
-        ci.stageCount = 2;
-        ci.pStages = stages;
-        ci.pVertexInputState = &vi;
-        ci.pInputAssemblyState = &ia;
-        ci.pViewportState = &vp;
-        ci.pRasterizationState = &rs;
-        ci.pMultisampleState = &ms;
-        ci.pDepthStencilState = &ds;
-        ci.pColorBlendState = &cb;
-        ci.pDynamicState = &dy;
-        ci.layout = layout_;
-        ci.renderPass = render_pass_;
-        ci.subpass = 0;
-        check(vkCreateGraphicsPipelines(dev, VK_NULL_HANDLE, 1, &ci, nullptr, &pipeline_), "vkCreateGraphicsPipelines");
+        StageModules modules(dev); // destroyed once the pipeline holds the code, or on failure
+        const VkPipelineShaderStageCreateInfo stages[2] = {modules.create(VK_SHADER_STAGE_VERTEX_BIT, *d.vertex),
+                                                           modules.create(VK_SHADER_STAGE_FRAGMENT_BIT, *d.fragment)};
+        pipeline_ = create_pipeline(dev, d, stages, layout_, render_pass_);
     } catch (...) {
-        for (VkShaderModule m : modules)
-            if (m) vkDestroyShaderModule(dev, m, nullptr);
         release();
         throw;
     }
-    for (VkShaderModule m : modules) vkDestroyShaderModule(dev, m, nullptr);
 }
 
 GraphicsPipeline::~GraphicsPipeline() { release(); }

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <regex>
 #include <set>
 #include <sstream>
@@ -170,86 +171,115 @@ CompiledShader compile_shader_file(const fs::path& path, const Defines& defines,
 }
 
 namespace {
-CompiledShader compile_stage_file(const fs::path& path_in, Stage stage, const Defines& defines, const CompileOptions& options) {
-    fs::path path = fs::weakly_canonical(path_in);
+// The cache key: the stage, the source and every file it includes, the defines, and the passes
+// (with their versions) that rewrite the module.
+std::string cache_key(const fs::path& path, Stage stage, const Defines& defines, const CompileOptions& options) {
     Fnv1a64 h;
     h.update(std::string(stage.key) + ";glslang-vulkan1.2;");
     std::set<fs::path> seen;
     hash_sources(path, h, seen);
-    std::string preamble = "#extension GL_GOOGLE_include_directive : require\n";
     for (const auto& [k, v] : defines) {
-        preamble += "#define " + k + " " + v + "\n";
-        h.update(k + "=" + v + ";");
+        std::string entry = k;
+        h.update(entry.append("=").append(v).append(";"));
     }
     if (options.count_instructions) h.update("count_instructions=" + std::to_string(kCostPassVersion) + ";");
     if (options.emulate_fp16) h.update("pass:fp16-emulation:" IBLCHECK_FP16_PASS_HASH ";");
-    CompiledShader out;
-    out.source_hash = h.hex();
-    out.counts_instructions = options.count_instructions;
+    return h.hex();
+}
 
-    fs::path cached = spirv_cache_dir() / (out.source_hash + ".spv");
-    if (std::ifstream f{cached, std::ios::binary}) {
-        std::vector<char> bytes((std::istreambuf_iterator<char>(f)), {});
-        if (bytes.size() >= 20 && bytes.size() % 4 == 0) {
-            out.spirv.resize(bytes.size() / 4);
-            std::memcpy(out.spirv.data(), bytes.data(), bytes.size());
-            if (out.spirv[0] == 0x07230203u) {
-                out.from_cache = true;
-                return out;
-            }
-        }
+std::string preamble_of(const Defines& defines) {
+    std::string preamble = "#extension GL_GOOGLE_include_directive : require\n";
+    for (const auto& [k, v] : defines) preamble.append("#define ").append(k).append(" ").append(v).append("\n");
+    return preamble;
+}
+
+// The module cached in `file`, if there is a whole one (a SPIR-V header at least, and whole words).
+std::optional<std::vector<uint32_t>> read_cached(const fs::path& file) {
+    std::ifstream f{file, std::ios::binary};
+    if (!f) return std::nullopt;
+    std::vector<char> bytes((std::istreambuf_iterator<char>(f)), {});
+    if (bytes.size() < 20 || bytes.size() % 4 != 0) return std::nullopt;
+    std::vector<uint32_t> spirv(bytes.size() / 4);
+    std::memcpy(spirv.data(), bytes.data(), bytes.size());
+    if (spirv[0] != 0x07230203u) return std::nullopt;
+    return spirv;
+}
+
+// Write-then-rename so a concurrent reader never sees a half-written file. A cache that cannot be
+// written is no error: the next compile does the work again.
+void write_cached(const fs::path& file, const std::vector<uint32_t>& spirv) {
+    std::error_code ec;
+    fs::create_directories(file.parent_path(), ec);
+    if (ec) return;
+    fs::path tmp = file;
+    tmp += ".tmp" + std::to_string(::getpid());
+    if (std::ofstream f{tmp, std::ios::binary}) {
+        f.write(reinterpret_cast<const char*>(spirv.data()), std::streamsize(spirv.size() * 4));
+        f.close();
+        fs::rename(tmp, file, ec);
     }
+}
 
+// GLSL (version 460, Vulkan rules) to SPIR-V 1.5 for Vulkan 1.2, unoptimised. glslang's process
+// state is global: one compile at a time.
+std::vector<uint32_t> glslang_compile(const fs::path& path, EShLanguage language, const std::string& preamble) {
     std::string source = read_text(path);
-    {
-        std::lock_guard lock(compile_mutex());
-        static GlslangProcess process;
-        glslang::TShader shader(stage.language);
-        const char* src = source.c_str();
-        std::string name = path.string();
-        const char* names = name.c_str();
-        shader.setStringsWithLengthsAndNames(&src, nullptr, &names, 1);
-        shader.setPreamble(preamble.c_str());
-        shader.setEntryPoint("main");
-        shader.setEnvInput(glslang::EShSourceGlsl, stage.language, glslang::EShClientVulkan, 100);
-        shader.setEnvClient(glslang::EShClientVulkan, glslang::EShTargetVulkan_1_2);
-        shader.setEnvTarget(glslang::EShTargetSpv, glslang::EShTargetSpv_1_5);
-        FileIncluder includer;
-        auto msgs = static_cast<EShMessages>(EShMsgSpvRules | EShMsgVulkanRules);
-        if (!shader.parse(GetDefaultResources(), 460, false, msgs, includer))
-            throw ShaderCompileError(format_log(shader.getInfoLog()));
-        glslang::TProgram program;
-        program.addShader(&shader);
-        if (!program.link(msgs)) throw ShaderCompileError(name + ": link: " + format_log(program.getInfoLog()));
-        glslang::SpvOptions opt;
-        opt.disableOptimizer = true; // lavapipe's LLVM optimises; keep SPIR-V faithful to the source
-        glslang::GlslangToSpv(*program.getIntermediate(stage.language), out.spirv, &opt);
-    }
+    std::lock_guard lock(compile_mutex());
+    static GlslangProcess process;
+    glslang::TShader shader(language);
+    const char* src = source.c_str();
+    std::string name = path.string();
+    const char* names = name.c_str();
+    shader.setStringsWithLengthsAndNames(&src, nullptr, &names, 1);
+    shader.setPreamble(preamble.c_str());
+    shader.setEntryPoint("main");
+    shader.setEnvInput(glslang::EShSourceGlsl, language, glslang::EShClientVulkan, 100);
+    shader.setEnvClient(glslang::EShClientVulkan, glslang::EShTargetVulkan_1_2);
+    shader.setEnvTarget(glslang::EShTargetSpv, glslang::EShTargetSpv_1_5);
+    FileIncluder includer;
+    auto msgs = static_cast<EShMessages>(EShMsgSpvRules | EShMsgVulkanRules);
+    if (!shader.parse(GetDefaultResources(), 460, false, msgs, includer))
+        throw ShaderCompileError(format_log(shader.getInfoLog()));
+    glslang::TProgram program;
+    program.addShader(&shader);
+    if (!program.link(msgs)) throw ShaderCompileError(name + ": link: " + format_log(program.getInfoLog()));
+    glslang::SpvOptions opt;
+    opt.disableOptimizer = true; // lavapipe's LLVM optimises; keep SPIR-V faithful to the source
+    std::vector<uint32_t> spirv;
+    glslang::GlslangToSpv(*program.getIntermediate(language), spirv, &opt);
+    return spirv;
+}
+
+// The SPIR-V passes `options` asks for, in their one valid order.
+void apply_passes(std::vector<uint32_t>& spirv, const CompileOptions& options, const fs::path& path) {
     // The count comes before the fp16 emulation: it measures the shader as written (what a device
     // with native fp16 executes), so the cost a baseline records is the same on every CPU class.
     // The emulation only rewrites 16-bit float instructions and adds no blocks, so the counter's
     // per-block increments (64-bit integers) pass through it unchanged.
-    if (options.count_instructions) out.spirv = instrument_instruction_count(out.spirv);
+    if (options.count_instructions) spirv = instrument_instruction_count(spirv);
     if (options.emulate_fp16) {
         try {
-            emulate_fp16(out.spirv);
+            emulate_fp16(spirv);
         } catch (const ShaderCompileError& e) {
             throw ShaderCompileError(path.string() + ": " + e.what());
         }
     }
+}
 
-    std::error_code ec;
-    fs::create_directories(spirv_cache_dir(), ec);
-    if (!ec) {
-        // Write-then-rename so a concurrent reader never sees a half-written file.
-        fs::path tmp = cached;
-        tmp += ".tmp" + std::to_string(::getpid());
-        if (std::ofstream f{tmp, std::ios::binary}) {
-            f.write(reinterpret_cast<const char*>(out.spirv.data()), out.spirv.size() * 4);
-            f.close();
-            fs::rename(tmp, cached, ec);
-        }
+CompiledShader compile_stage_file(const fs::path& path_in, Stage stage, const Defines& defines, const CompileOptions& options) {
+    const fs::path path = fs::weakly_canonical(path_in);
+    CompiledShader out;
+    out.source_hash = cache_key(path, stage, defines, options);
+    out.counts_instructions = options.count_instructions;
+    const fs::path cached = spirv_cache_dir() / (out.source_hash + ".spv");
+    if (auto spirv = read_cached(cached)) {
+        out.spirv = std::move(*spirv);
+        out.from_cache = true;
+        return out;
     }
+    out.spirv = glslang_compile(path, stage.language, preamble_of(defines));
+    apply_passes(out.spirv, options, path);
+    write_cached(cached, out.spirv);
     return out;
 }
 
