@@ -7,21 +7,14 @@
 #include <string>
 
 #include "renderers/reference/reference.h"
+#include "tests/reference_spec.h"
 
 using namespace iblcheck;
 
 namespace {
 constexpr double kPi = 3.14159265358979323846;
 
-TestSpec spec_of(const std::string& scene, const std::string& env, int spp, int w = 0, int h = 0) {
-    TestSpec s;
-    s.scene = scene;
-    s.env = env;
-    s.method = "reference";
-    s.width = w, s.height = h;
-    s.options.set("spp", std::to_string(spp));
-    return s;
-}
+using testutil::reference_spec;
 } // namespace
 
 TEST(EnvDistribution, PdfIntegratesToOneAndMatchesSampling) {
@@ -104,7 +97,7 @@ TEST(EnvDistribution, CellSamplingMatchesPdfAndSolidAngle) {
 // under studio at 256 spp).
 TEST(ReferenceIntegrator, WindowedEnvSamplingIsUnbiasedAndLessNoisy) {
     // Studio sweep, 16x16 px per sphere: per-sphere sums agree within 1 % (every lobe and roughness).
-    TestSpec spec = spec_of("roughness_sweep", "studio", 1024, 176, 32);
+    TestSpec spec = reference_spec("roughness_sweep", "studio", 1024, 176, 32);
     spec.options.set("env_sampling", "global");
     ReferenceRender g = render_reference_full(spec);
     spec.options.set("env_sampling", "window");
@@ -120,7 +113,7 @@ TEST(ReferenceIntegrator, WindowedEnvSamplingIsUnbiasedAndLessNoisy) {
         }
     // The sun's highlight on a r = 0.2 metal sphere: the 5e4 sun must not be lost by a window. Heavy-tailed
     // at low spp (at 1024 spp on 16 px spheres four seeds scattered by ±3 %), so 16384 spp on 32x32.
-    TestSpec sun = spec_of("sphere", "sky_sun", 16384, 32, 32);
+    TestSpec sun = reference_spec("sphere", "sky_sun", 16384, 32, 32);
     sun.options.set("roughness", "0.2");
     sun.options.set("metallic", "1");
     sun.options.set("env_sampling", "global");
@@ -129,7 +122,7 @@ TEST(ReferenceIntegrator, WindowedEnvSamplingIsUnbiasedAndLessNoisy) {
     const cv::Scalar mw = cv::mean(render_reference(sun).image);
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(mw[c] / mg[c], 1.0, 1e-2) << "channel " << c;
     std::printf("sun highlight, r=0.2 metal: mean R %.4f (global) vs %.4f (window)\n", mg[0], mw[0]);
-    TestSpec d = spec_of("sphere", "studio", 0, 64, 64);
+    TestSpec d = reference_spec("sphere", "studio", 0, 64, 64);
     d.options.set("lobes", "diffuse");
     d.options.set("env_sampling", "global");
     NoiseFloor ng = measure_noise_floor(d, 128);

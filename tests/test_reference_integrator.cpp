@@ -10,6 +10,7 @@
 
 #include "renderers/material_model.h"
 #include "renderers/reference/reference.h"
+#include "tests/reference_spec.h"
 
 using namespace iblcheck;
 
@@ -103,15 +104,7 @@ struct AlbedoTable {
     }
 };
 
-TestSpec spec_of(const std::string& scene, const std::string& env, int spp, int w = 0, int h = 0) {
-    TestSpec s;
-    s.scene = scene;
-    s.env = env;
-    s.method = "reference";
-    s.width = w, s.height = h;
-    s.options.set("spp", std::to_string(spp));
-    return s;
-}
+using testutil::reference_spec;
 
 // n·v averaged over a k×k grid inside pixel (x, y); false if any of the grid points (or the pixel's
 // corners) misses its sphere, i.e. the pixel is not fully covered.
@@ -158,7 +151,7 @@ TEST(ReferenceIntegrator, FurnaceMetalMatchesQuadrature) {
     // 16384 spp: in a constant environment the windowed environment strategy (the default) competes with
     // the exact GGX sampling under MIS instead of helping it; the worst pixel at 8192 spp was 0.21 %
     // (0.196 % with the unwindowed distribution), noise, not bias (it halves with 4x the samples).
-    TestSpec spec = spec_of("furnace", "constant:1", 16384, 120, 24);
+    TestSpec spec = reference_spec("furnace", "constant:1", 16384, 120, 24);
     ReferenceRender r = render_reference_full(spec);
     Scene s = build_scene("furnace", {});
     const int W = r.result.image.cols, H = r.result.image.rows;
@@ -199,12 +192,12 @@ TEST(ReferenceIntegrator, FurnaceDielectricIsLambertPlusSpecular) {
     // 16384 spp for the Lambert-only render (was 4096): the windowed environment strategy follows the
     // dilated cosine and so competes with the exact cosine sampling in a constant environment; the worst
     // pixel at 4096 spp was 0.42 %.
-    TestSpec diff = spec_of("furnace_dielectric", "constant:1", 16384, 120, 24);
+    TestSpec diff = reference_spec("furnace_dielectric", "constant:1", 16384, 120, 24);
     diff.options.set("lobes", "diffuse");
     ReferenceRender rd = render_reference_full(diff);
-    TestSpec all = spec_of("furnace_dielectric", "constant:1", 8192, 120, 24);
+    TestSpec all = reference_spec("furnace_dielectric", "constant:1", 8192, 120, 24);
     ReferenceRender ra = render_reference_full(all);
-    TestSpec spec_only = spec_of("furnace_dielectric", "constant:1", 8192, 120, 24);
+    TestSpec spec_only = reference_spec("furnace_dielectric", "constant:1", 8192, 120, 24);
     spec_only.options.set("lobes", "specular");
     ReferenceRender rs = render_reference_full(spec_only);
     const int W = ra.result.image.cols, H = ra.result.image.rows;
@@ -275,7 +268,7 @@ Environment patch_env(const float d[3], int k, float L, double& solid_angle) {
 TEST(ReferenceIntegrator, SmallPatchMatchesAnalyticBrdf) {
     const int W = 64, H = 64, px = 40, py = 22;
     for (double rough : {0.5, 0.35}) {
-        TestSpec spec = spec_of("sphere", "patch", 256, W, H);
+        TestSpec spec = reference_spec("sphere", "patch", 256, W, H);
         spec.options.set("roughness", std::to_string(rough));
         spec.options.set("metallic", "1");
         spec.options.set("base_color", "1");
@@ -318,7 +311,7 @@ TEST(ReferenceIntegrator, SmallPatchMatchesAnalyticBrdf) {
     }
     // Mirror (r = 0, F0 = 1): a patch wider than the pixel's reflected footprint reads exactly L.
     {
-        TestSpec spec = spec_of("sphere", "patch", 64, W, H);
+        TestSpec spec = reference_spec("sphere", "patch", 64, W, H);
         spec.options.set("roughness", "0");
         spec.options.set("metallic", "1");
         Scene s = build_scene("sphere", spec.options);
@@ -338,7 +331,7 @@ TEST(ReferenceIntegrator, SmallPatchMatchesAnalyticBrdf) {
 }
 
 TEST(ReferenceIntegrator, DeterministicAcrossThreadsAndRuns) {
-    TestSpec spec = spec_of("roughness_sweep", "sky_sun", 8, 176, 32);
+    TestSpec spec = reference_spec("roughness_sweep", "sky_sun", 8, 176, 32);
     spec.options.set("threads", "1");
     RenderResult a = render_reference(spec);
     spec.options.set("threads", "2");
@@ -356,7 +349,7 @@ TEST(ReferenceIntegrator, DeterministicAcrossThreadsAndRuns) {
 }
 
 TEST(ReferenceIntegrator, ResultAndProvenance) {
-    TestSpec spec = spec_of("sphere", "studio", 4, 32, 32);
+    TestSpec spec = reference_spec("sphere", "studio", 4, 32, 32);
     spec.options.set("env_rotation", "45");
     RenderResult r = render_reference(spec);
     EXPECT_EQ(r.image.type(), CV_32FC3);
@@ -371,11 +364,11 @@ TEST(ReferenceIntegrator, ResultAndProvenance) {
     EXPECT_FLOAT_EQ(r.provenance["env"]["rotation_deg"].get<float>(), 45.0f);
     EXPECT_GT(r.texture_fetches_per_pixel, 1.0);
     EXPECT_LT(r.texture_fetches_per_pixel, 2.0 * 4 + 1e-9);
-    EXPECT_THROW(render_reference(spec_of("nope", "studio", 4)), UsageError);
+    EXPECT_THROW(render_reference(reference_spec("nope", "studio", 4)), UsageError);
 }
 
 TEST(ReferenceIntegrator, NoiseFloorShrinksWithSpp) {
-    TestSpec spec = spec_of("sphere", "studio", 0, 48, 48);
+    TestSpec spec = reference_spec("sphere", "studio", 0, 48, 48);
     NoiseFloor lo = measure_noise_floor(spec, 16);
     NoiseFloor hi = measure_noise_floor(spec, 256);
     EXPECT_GT(lo.relative_rmse, 0);
@@ -390,7 +383,7 @@ TEST(ReferenceIntegrator, NoiseFloorShrinksWithSpp) {
 // and on the mirror sphere (lobes=specular, r = 0: the shading is deterministic per position, so the
 // difference is the pattern error alone) almost the same image.
 TEST(ReferenceIntegrator, PixelPatternErrorIsSmall) {
-    TestSpec spec = spec_of("sphere", "studio", 8192, 64, 64); // positions = spp/4 = 2048
+    TestSpec spec = reference_spec("sphere", "studio", 8192, 64, 64); // positions = spp/4 = 2048
     spec.options.set("roughness", "0");
     spec.options.set("metallic", "1");
     spec.options.set("lobes", "specular");
