@@ -10,6 +10,8 @@
 //   on the worst 16x16 block that follows the pointer (click pins it); the FLIP heatmap on a chosen
 //   scale with its colour bar and the exceedance mask; the sphere and values under the pointer;
 // - the load check tests/test_report.cpp reads back from <body>: images, data scripts, viewers.
+// buildViewer() is ~110 lines on purpose: one closure that holds a viewer's state (exposure, zoom, mask,
+// the pinned block) and the handlers that read and redraw it; split, the state would travel in arguments.
 #pragma once
 
 namespace iblcheck::report::assets {

@@ -88,6 +88,8 @@ TEST(ReportBrowser, OpensOfflineWithEveryImageAndDataScriptLoaded) {
     fs::remove_all(profile);
 }
 
+// One headless-browser session that steps through the page as a reader does (first screen, the failing
+// card, its viewer, the tabs): ~110 lines on purpose, each step needs the page state the one before left.
 TEST(ReportBrowser, CiReportWithOneFailureReadsInTheFirstScreenAndItsViewerWorks) {
     if (!Browser::available()) GTEST_SKIP() << Browser::kChromium << " is not installed (Debian package chromium)";
     const fs::path dir = testutil::temp_dir("browser_ci");
