@@ -131,16 +131,8 @@ std::optional<double> shade_with_compute(GpuSession& gpu, const ShadingInputs& i
     std::vector<vk::Binding> b = in.bindings;
     b.push_back(vk::Binding::storage_buffer(5, out));
     const ShadePush& pc = in.push;
-    vk::GpuTimer timer(ctx, 1);
-    ctx.submit([&](VkCommandBuffer cmd) {
-        timer.reset(cmd);
-        shade.warm_up(cmd, b, &pc, sizeof pc);
-        timer.begin(cmd, "shade_spheres");
-        shade.dispatch(cmd, b, &pc, sizeof pc, (width + 7) / 8, (height + 7) / 8, 1);
-        timer.end(cmd);
-        ctx.barrier(cmd);
-    });
-    for (auto& [name, ms] : timer.results()) result.timings.push_back({name, ms, true, false});
+    for (auto& [name, ms] : shade.dispatch_timed("shade_spheres", b, &pc, sizeof pc, (width + 7) / 8, (height + 7) / 8))
+        result.timings.push_back({name, ms, true, false});
     double coverage = read_back_image(out, width, height, result.image);
     // One shading per ray that hits.
     result.texture_fetches_per_pixel = coverage * pc.ssaa * pc.ssaa * in.per_hit;

@@ -51,16 +51,8 @@ RenderResult render_sampled(GpuSession& gpu, const Environment& env, const TestS
                                   vk::Binding::storage_buffer(3, ibl.sh),
                                   vk::Binding::storage_buffer(4, ibl.sh),
                                   vk::Binding::storage_buffer(5, out)};
-    vk::GpuTimer timer(ctx, 1);
-    ctx.submit([&](VkCommandBuffer cmd) {
-        timer.reset(cmd);
-        shade.warm_up(cmd, b, &pc, sizeof pc);
-        timer.begin(cmd, "shade_sampled");
-        shade.dispatch(cmd, b, &pc, sizeof pc, (width + 7) / 8, (height + 7) / 8, 1);
-        timer.end(cmd);
-        ctx.barrier(cmd);
-    });
-    for (auto& [name, ms] : timer.results()) result.timings.push_back({name, ms, true, false});
+    for (auto& [name, ms] : shade.dispatch_timed("shade_sampled", b, &pc, sizeof pc, (width + 7) / 8, (height + 7) / 8))
+        result.timings.push_back({name, ms, true, false});
     double coverage = read_back_image(out, width, height, result.image);
     result.texture_fetches_per_pixel = coverage * pc.ssaa * pc.ssaa * samples;
     auto instructions =

@@ -1,34 +1,53 @@
-// Compute pipelines with push descriptors and push constants, and the descriptor writes the
-// compute and graphics pipelines share (Context::push_descriptors).
+// Compute pipelines with push descriptors and push constants, and what the compute and graphics
+// pipelines share: their layouts (pipeline_layout.h) and the descriptor writes (Context::push_descriptors).
 #include "context.h"
 #include "harness/common/errors.h"
+#include "pipeline_layout.h"
 #include "spirv_cost.h"
 #include "vk_struct.h"
 
 namespace iblcheck::vk {
 
+std::vector<VkDescriptorSetLayoutBinding> layout_bindings(const std::vector<VkDescriptorType>& bindings, bool counts,
+                                                          VkShaderStageFlags stages, const char* owner) {
+    std::vector<VkDescriptorSetLayoutBinding> lb;
+    for (uint32_t i = 0; i < bindings.size(); ++i) lb.push_back({i, bindings[i], 1, stages, nullptr});
+    if (counts && bindings.size() > kCostBinding)
+        throw Error(std::string(owner) + ": binding " + std::to_string(kCostBinding) + " is the instruction counter's");
+    if (counts) lb.push_back({kCostBinding, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, stages, nullptr});
+    return lb;
+}
+
+VkDescriptorSetLayout create_set_layout(VkDevice dev, const std::vector<VkDescriptorSetLayoutBinding>& bindings) {
+    auto dl = vk_struct<VkDescriptorSetLayoutCreateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO);
+    dl.flags = VK_DESCRIPTOR_SET_LAYOUT_CREATE_PUSH_DESCRIPTOR_BIT_KHR;
+    dl.bindingCount = uint32_t(bindings.size());
+    dl.pBindings = bindings.data();
+    VkDescriptorSetLayout layout = VK_NULL_HANDLE;
+    check(vkCreateDescriptorSetLayout(dev, &dl, nullptr, &layout), "vkCreateDescriptorSetLayout");
+    return layout;
+}
+
+VkPipelineLayout create_pipeline_layout(VkDevice dev, VkDescriptorSetLayout set_layout, uint32_t push_constant_bytes,
+                                        VkShaderStageFlags stages) {
+    VkPushConstantRange pcr{stages, 0, push_constant_bytes};
+    auto pl = vk_struct<VkPipelineLayoutCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO);
+    pl.setLayoutCount = 1;
+    pl.pSetLayouts = &set_layout;
+    pl.pushConstantRangeCount = push_constant_bytes ? 1 : 0;
+    pl.pPushConstantRanges = &pcr;
+    VkPipelineLayout layout = VK_NULL_HANDLE;
+    check(vkCreatePipelineLayout(dev, &pl, nullptr, &layout), "vkCreatePipelineLayout");
+    return layout;
+}
+
 ComputePipeline::ComputePipeline(Context& ctx, const CompiledShader& shader, const std::vector<VkDescriptorType>& bindings,
                                  uint32_t push_constant_bytes, const std::vector<SpecConstant>& spec)
     : ctx_(ctx), push_bytes_(push_constant_bytes) {
     VkDevice dev = ctx.device();
-    std::vector<VkDescriptorSetLayoutBinding> lb;
-    for (uint32_t i = 0; i < bindings.size(); ++i) lb.push_back({i, bindings[i], 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr});
-    if (shader.counts_instructions && bindings.size() > kCostBinding)
-        throw Error("ComputePipeline: binding " + std::to_string(kCostBinding) + " is the instruction counter's");
-    if (shader.counts_instructions)
-        lb.push_back({kCostBinding, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr});
-    auto dl = vk_struct<VkDescriptorSetLayoutCreateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO);
-    dl.flags = VK_DESCRIPTOR_SET_LAYOUT_CREATE_PUSH_DESCRIPTOR_BIT_KHR;
-    dl.bindingCount = uint32_t(lb.size());
-    dl.pBindings = lb.data();
-    check(vkCreateDescriptorSetLayout(dev, &dl, nullptr, &set_layout_), "vkCreateDescriptorSetLayout");
-    VkPushConstantRange pcr{VK_SHADER_STAGE_COMPUTE_BIT, 0, push_constant_bytes};
-    auto pl = vk_struct<VkPipelineLayoutCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO);
-    pl.setLayoutCount = 1;
-    pl.pSetLayouts = &set_layout_;
-    pl.pushConstantRangeCount = push_constant_bytes ? 1 : 0;
-    pl.pPushConstantRanges = &pcr;
-    check(vkCreatePipelineLayout(dev, &pl, nullptr, &layout_), "vkCreatePipelineLayout");
+    set_layout_ = create_set_layout(
+        dev, layout_bindings(bindings, shader.counts_instructions, VK_SHADER_STAGE_COMPUTE_BIT, "ComputePipeline"));
+    layout_ = create_pipeline_layout(dev, set_layout_, push_constant_bytes, VK_SHADER_STAGE_COMPUTE_BIT);
 
     auto smi = vk_struct<VkShaderModuleCreateInfo>(VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO);
     smi.codeSize = shader.spirv.size() * 4;
@@ -52,6 +71,22 @@ ComputePipeline::ComputePipeline(Context& ctx, const CompiledShader& shader, con
     VkResult r = vkCreateComputePipelines(dev, VK_NULL_HANDLE, 1, &ci, nullptr, &pipeline_);
     vkDestroyShaderModule(dev, module, nullptr);
     check(r, "vkCreateComputePipelines");
+}
+
+std::vector<std::pair<std::string, double>> ComputePipeline::dispatch_timed(const std::string& name,
+                                                                            const std::vector<Binding>& bindings,
+                                                                            const void* push, uint32_t push_bytes, uint32_t gx,
+                                                                            uint32_t gy, uint32_t gz) const {
+    GpuTimer timer(ctx_, 1);
+    ctx_.submit([&](VkCommandBuffer cmd) {
+        timer.reset(cmd);
+        warm_up(cmd, bindings, push, push_bytes);
+        timer.begin(cmd, name);
+        dispatch(cmd, bindings, push, push_bytes, gx, gy, gz);
+        timer.end(cmd);
+        Context::barrier(cmd);
+    });
+    return timer.results();
 }
 
 ComputePipeline::~ComputePipeline() {

@@ -122,6 +122,12 @@ class ComputePipeline {
     void dispatch(VkCommandBuffer cmd, const std::vector<Binding>& bindings, const void* push, uint32_t push_bytes, uint32_t gx,
                   uint32_t gy = 1, uint32_t gz = 1) const;
 
+    // The timed pass a renderer reports: submits warm_up and one dispatch between timestamps named
+    // `name` (GpuTimer), waits, and returns {name, milliseconds}.
+    std::vector<std::pair<std::string, double>> dispatch_timed(const std::string& name, const std::vector<Binding>& bindings,
+                                                               const void* push, uint32_t push_bytes, uint32_t gx,
+                                                               uint32_t gy = 1, uint32_t gz = 1) const;
+
   private:
     Context& ctx_;
     VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;

@@ -3,6 +3,7 @@
 #include <string>
 
 #include "harness/common/errors.h"
+#include "pipeline_layout.h"
 #include "spirv_cost.h"
 #include "vk_struct.h"
 
@@ -78,39 +79,6 @@ uint32_t texel_bytes(VkFormat f) {
     case VK_FORMAT_R8G8B8A8_UNORM: return 4;
     default: throw Error("OffscreenTarget: copy of this colour format is not implemented");
     }
-}
-
-// Binding i of type bindings[i] in both stages, and the instruction counter's when `counts`.
-std::vector<VkDescriptorSetLayoutBinding> layout_bindings(const std::vector<VkDescriptorType>& bindings, bool counts) {
-    std::vector<VkDescriptorSetLayoutBinding> lb;
-    for (uint32_t i = 0; i < bindings.size(); ++i) lb.push_back({i, bindings[i], 1, kStages, nullptr});
-    if (counts && bindings.size() > kCostBinding)
-        throw Error("GraphicsPipeline: binding " + std::to_string(kCostBinding) + " is the instruction counter's");
-    if (counts) lb.push_back({kCostBinding, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, kStages, nullptr});
-    return lb;
-}
-
-VkDescriptorSetLayout create_set_layout(VkDevice dev, const std::vector<VkDescriptorSetLayoutBinding>& bindings) {
-    auto dl = vk_struct<VkDescriptorSetLayoutCreateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO);
-    dl.flags = VK_DESCRIPTOR_SET_LAYOUT_CREATE_PUSH_DESCRIPTOR_BIT_KHR;
-    dl.bindingCount = uint32_t(bindings.size());
-    dl.pBindings = bindings.data();
-    VkDescriptorSetLayout layout = VK_NULL_HANDLE;
-    check(vkCreateDescriptorSetLayout(dev, &dl, nullptr, &layout), "vkCreateDescriptorSetLayout");
-    return layout;
-}
-
-// Set 0 and, when `push_constant_bytes` > 0, one push-constant range both stages see.
-VkPipelineLayout create_pipeline_layout(VkDevice dev, VkDescriptorSetLayout set_layout, uint32_t push_constant_bytes) {
-    VkPushConstantRange pcr{kStages, 0, push_constant_bytes};
-    auto pl = vk_struct<VkPipelineLayoutCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO);
-    pl.setLayoutCount = 1;
-    pl.pSetLayouts = &set_layout;
-    pl.pushConstantRangeCount = push_constant_bytes ? 1 : 0;
-    pl.pPushConstantRanges = &pcr;
-    VkPipelineLayout layout = VK_NULL_HANDLE;
-    check(vkCreatePipelineLayout(dev, &pl, nullptr, &layout), "vkCreatePipelineLayout");
-    return layout;
 }
 
 // The vertex and fragment shader modules, destroyed with this object.
@@ -349,10 +317,10 @@ GraphicsPipeline::GraphicsPipeline(Context& ctx, const GraphicsPipelineDesc& d) 
         throw EnvironmentError(
             ctx.info().device_name +
             ": counting a draw's instructions needs vertexPipelineStoresAndAtomics and fragmentStoresAndAtomics");
-    const std::vector<VkDescriptorSetLayoutBinding> bindings = layout_bindings(d.bindings, counts_);
+    const std::vector<VkDescriptorSetLayoutBinding> bindings = layout_bindings(d.bindings, counts_, kStages, "GraphicsPipeline");
     try {
         set_layout_ = create_set_layout(dev, bindings);
-        layout_ = create_pipeline_layout(dev, set_layout_, d.push_constant_bytes);
+        layout_ = create_pipeline_layout(dev, set_layout_, d.push_constant_bytes, kStages);
         render_pass_ = create_render_pass(dev, d.target);
         StageModules modules(dev); // destroyed once the pipeline holds the code, or on failure
         const VkPipelineShaderStageCreateInfo stages[2] = {modules.create(VK_SHADER_STAGE_VERTEX_BIT, *d.vertex),
