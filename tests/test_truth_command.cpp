@@ -85,4 +85,15 @@ TEST_F(TruthCommand, MonteCarloOptionsNeedTheMonteCarloIntegrator) {
     }
 }
 
+// A count that is not positive is a usage error, not a silent plain golden (--frames 0 used to write the
+// single-image golden as if --frames had not been given).
+TEST_F(TruthCommand, FramesAndSppMustBePositive) {
+    std::string out;
+    for (const std::string bad : {" --frames 0", " --frames -2", " --integrator monte_carlo --spp 0"}) {
+        const int rc = testutil::run_command(kCli + " truth --scene sphere --env constant:1 --out " + path("x.exr") + bad, out);
+        EXPECT_EQ(rc, 2) << bad << "\n" << out;
+        EXPECT_FALSE(fs::exists(path("x.exr"))) << bad;
+    }
+}
+
 } // namespace

@@ -200,13 +200,16 @@ void register_truth_command(CLI::App& app, int& exit_code) {
                     "truth_tolerance (the coarser level's pixel tolerance)");
     cmd->add_option("--frames", a.frames,
                     "Render the temporal truth: frames 0..N-1 (option frame) stacked vertically "
-                    "in one golden, as the temporal suite reads it (reference/<key>__frames=N.exr)");
+                    "in one golden, as the temporal suite reads it (reference/<key>__frames=N.exr)")
+        ->check(CLI::Range(1, 1 << 20)); // --frames 0 is not "no sequence": it is a mistake
     cmd->add_option("--integrator", a.integrator,
                     "quadrature (the deterministic truth) or monte_carlo (the Monte Carlo integrator, with its noise "
                     "floor between seeds K and K+1 in the sidecar; the near-mirror golden)")
         ->check(CLI::IsMember({"quadrature", "monte_carlo"}))
         ->capture_default_str();
-    cmd->add_option("--spp", a.spp, "monte_carlo: lighting samples per pixel")->capture_default_str();
+    cmd->add_option("--spp", a.spp, "monte_carlo: lighting samples per pixel")
+        ->check(CLI::Range(1, 1 << 30))
+        ->capture_default_str();
     cmd->add_option("--seed", a.seed, "monte_carlo: the golden's lighting seed K (the noise floor renders K+1 too)")
         ->capture_default_str();
     cmd->add_option("--tiles", a.tiles,
