@@ -7,12 +7,14 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 
 #include <nlohmann/json.hpp>
 
 #include "harness/common/errors.h"
 #include "metrics/display_transform.h"
 #include "metrics/flip.h"
+#include "metrics/flip/kernels.h"
 #include "metrics/flip/magma_table.h"
 #include "metrics/flip_json.h"
 #include "metrics/image_io.h"
@@ -212,6 +214,43 @@ TEST(Flip, MagmaHeatmapMatchesTable) {
     EXPECT_FLOAT_EQ(p[5], 0.749504f);
     EXPECT_FLOAT_EQ(p[6], flip::kMagma[128][0]);
     EXPECT_FLOAT_EQ(p[9 + 1], flip::kMagma[10][1]);
+}
+
+// Issue 30: one finite pixel at 1e20 overflowed the tone mapper's c * c (inf/inf = NaN); FLIP's
+// running max over exposures lost the NaN, so the pixel and its neighbourhood scored 0 (or not,
+// depending on how each kernel clamped the NaN). It is scored now, the same by every kernel.
+TEST(Flip, AHugeFinitePixelIsScoredByEveryKernel) {
+    const cv::Mat a = synthetic(64, 48, 9, 0.05f) * 2.0;
+    cv::Mat hot = a.clone();
+    hot.at<cv::Vec3f>(20, 30) = cv::Vec3f(1e20f, 1e20f, 1e20f);
+    for (const flip::Kernels* k : flip::available_kernels()) {
+        FlipOptions o;
+        o.kernels = k;
+        for (const bool hot_is_test : {true, false}) {
+            const FlipResult r = hot_is_test ? compute_flip_hdr(a, hot, o) : compute_flip_hdr(hot, a, o);
+            EXPECT_TRUE(cv::checkRange(r.errmap)) << k->name;
+            // (The old code scored the pixel and its neighbours 0: the NaN lost to the running max.)
+            EXPECT_GT(r.errmap.at<float>(20, 30), 0.1f) << k->name << (hot_is_test ? " hot test" : " hot reference");
+            EXPECT_GT(r.errmap.at<float>(20, 31), 0.05f) << k->name << ": the neighbours see it through the filters";
+            EXPECT_GT(r.mean, 0.0) << k->name;
+        }
+        const FlipResult same = compute_flip_hdr(hot, hot, o);
+        EXPECT_EQ(same.max, 0.0) << k->name;
+    }
+}
+
+TEST(DisplayTransform, HugeFiniteValuesSaturateToWhite) {
+    // Each used to be NaN (c * c overflows float from 1.8e19).
+    const float white = display_transform_channel(1e6f); // ACES clamped to 1, then sRGB
+    EXPECT_NEAR(white, 1.0f, 1e-6);
+    for (float v : {1e18f, 1e19f, 1e20f, 3.4e38f}) EXPECT_EQ(display_transform_channel(v), white) << v;
+    EXPECT_TRUE(std::isnan(display_transform_channel(std::nanf("")))); // a NaN is not hidden
+    for (flip::ToneMapper tm : {flip::ToneMapper::aces, flip::ToneMapper::hable, flip::ToneMapper::reinhard}) {
+        float r = std::numeric_limits<float>::infinity(), g = 1e20f, b = 0.0f;
+        flip::tone_map(tm, r, g, b);
+        EXPECT_TRUE(std::isfinite(r) && std::isfinite(g) && std::isfinite(b)) << flip::tone_mapper_name(tm);
+        EXPECT_GE(std::min(r, 1.0f), 1.0f) << flip::tone_mapper_name(tm); // clamped by every caller
+    }
 }
 
 TEST(DisplayTransform, AcesThenSrgb) {

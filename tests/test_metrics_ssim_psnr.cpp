@@ -102,6 +102,19 @@ TEST(Ssim, HdrUsesTheDisplayTransform) {
     EXPECT_DOUBLE_EQ(compute_ssim_hdr(a, b).mean, compute_ssim(display_transform(a), display_transform(b)).mean);
 }
 
+TEST(Ssim, HdrWithAHugeFinitePixelIsANumber) {
+    // Issue 30: a pixel at 1e20 made the display transform NaN, so SSIM was NaN (null in the JSON)
+    // and a bit-identical render failed its golden forever.
+    const cv::Mat a = noise_image(40, 30, 6) * 4.0;
+    cv::Mat hot = a.clone();
+    hot.at<cv::Vec3f>(12, 17) = cv::Vec3f(1e20f, 1e20f, 1e20f);
+    EXPECT_EQ(compute_ssim_hdr(hot, hot).mean, 1.0);
+    const double s = compute_ssim_hdr(a, hot).mean;
+    EXPECT_TRUE(std::isfinite(s));
+    EXPECT_LT(s, 1.0);
+    EXPECT_GT(s, 0.9); // one pixel of 1200
+}
+
 TEST(Psnr, HandComputed) {
     const cv::Mat a(10, 10, CV_32FC3, cv::Scalar(0.5, 0.5, 0.5));
     cv::Mat b = a + cv::Scalar(0.1, 0.1, 0.1);

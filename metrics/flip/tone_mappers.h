@@ -39,14 +39,30 @@ inline const char* tone_mapper_name(ToneMapper tm) {
     }
 }
 
+// Inputs above this are computed as this. ACES and Hable approach k0/k3 > 1 from below, so they
+// pass 1 (every caller's clamp) long before it (ACES at 12.1, Hable at 5.6), and c * c overflows
+// float from 1.8e19: a pixel at 1e20 used to give inf/inf = NaN, which FLIP's running max over
+// exposures and SSIM then lost (an all-zero error map, SSIM null). Saturating changes nothing
+// below it and gives the exact clamped value above it; a NaN stays a NaN.
+inline constexpr float kToneMapSaturation = 1e18f;
+
 // One channel of the rational curve (not Reinhard).
 IBLCHECK_FLIP_INLINE float tone_map_channel(float c, const float* k) {
+    c = c > kToneMapSaturation ? kToneMapSaturation : c;
     return ((c * c) * k[0] + c * k[1] + k[2]) / ((c * c) * k[3] + c * k[4] + k[5]);
 }
+
+// Reinhard's c / (1 + Y) holds at any finite c below 1e38; an exposed value that overflowed to inf
+// (inf * 0 = NaN), or one where Y would round to inf, is computed as 1e38 (the same clamped output
+// to within 1e-37).
+IBLCHECK_FLIP_INLINE float reinhard_input(float c) { return c > 1e38f ? 1e38f : c; }
 
 // Tone-maps one linear RGB pixel in place.
 IBLCHECK_FLIP_INLINE void tone_map(ToneMapper tm, float& r, float& g, float& b) {
     if (tm == ToneMapper::reinhard) {
+        r = reinhard_input(r);
+        g = reinhard_input(g);
+        b = reinhard_input(b);
         const float lum = 0.2126f * r + 0.7152f * g + 0.0722f * b;
         const float factor = 1.0f / (1.0f + lum);
         r *= factor;
