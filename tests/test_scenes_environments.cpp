@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <limits>
 
+#include "harness/common/errors.h"
+#include "harness/common/options.h"
 #include "renderers/environments/environment.h"
 #include "renderers/environments/procedural.h"
 #include "renderers/scenes/coverage.h"
@@ -120,6 +122,43 @@ TEST(Environment, NaNIsAnInputErrorWithCountAndLocation) {
         EXPECT_NE(m.find("2 non-finite"), std::string::npos) << m;
         EXPECT_NE(m.find("(7, 3)"), std::string::npos) << m;
     }
+}
+
+// Issue 30: constant:1e39 became inf as a float and constant:1e38 overflowed the renderers' sums;
+// both gave an all-black render that passed and could be blessed.
+TEST(Environment, RadianceBeyondWhatTheRenderersSumIsRefused) {
+    auto message_of = [](const std::string& spec) -> std::string {
+        try {
+            load_environment(spec);
+        } catch (const Error& e) {
+            return e.what();
+        }
+        return "(loaded)";
+    };
+    std::string m = message_of("constant:1e39");
+    EXPECT_NE(m.find("'1e39' is beyond a 32-bit float's range"), std::string::npos) << m;
+    m = message_of("constant:1,1e38,1");
+    EXPECT_NE(m.find("environment 'constant:1,1e38,1': radiance 1e+38 at pixel (0, 0) channel 1 is above 1e+30"),
+              std::string::npos)
+        << m;
+    EXPECT_EQ(message_of("constant:1e30"), "(loaded)");
+    EXPECT_EQ(message_of("sky_sun"), "(loaded)");
+    cv::Mat img(16, 32, CV_32FC3, cv::Scalar(1, 1, 1));
+    img.at<cv::Vec3f>(4, 9)[2] = 2e31f;
+    fs::path p = temp_file("hot.exr");
+    write_exr(p, img);
+    m = message_of(p.string());
+    EXPECT_NE(m.find("(" + p.string() + "): radiance 2e+31 at pixel (9, 4) channel 2"), std::string::npos) << m;
+}
+
+TEST(Options, NumbersBeyondAFloatAreRefused) {
+    OptionMap o;
+    o.set("env_rotation", "1e39");
+    o.set("roughness", "-4e38");
+    o.set("ao", "3e38");
+    EXPECT_THROW(o.get_double("env_rotation", 0), UsageError); // was inf once cast to float
+    EXPECT_THROW(o.get_double("roughness", 0), UsageError);
+    EXPECT_EQ(o.get_double("ao", 0), 3e38);
 }
 
 TEST(Environment, NegativesAreClampedAndCounted) {

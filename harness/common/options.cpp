@@ -3,6 +3,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <sstream>
 
 namespace iblcheck {
@@ -20,6 +21,10 @@ double parse_double(const std::string& key, const std::string& text) {
     double v = std::strtod(text.c_str(), &end);
     if (text.empty() || end != text.c_str() + text.size() || errno == ERANGE || !std::isfinite(v))
         throw UsageError("option '" + key + "': '" + text + "' is not a finite number");
+    // The renderers read options as 32-bit floats: 1e39 became inf (constant:1e39, an all-black
+    // render that bless accepted).
+    if (std::fabs(v) > double(std::numeric_limits<float>::max()))
+        throw UsageError("option '" + key + "': '" + text + "' is beyond a 32-bit float's range (3.4e38)");
     return v;
 }
 } // namespace

@@ -8,6 +8,8 @@
 #include <cstdlib>
 #include <filesystem>
 
+#include <fmt/core.h>
+
 #include "harness/common/errors.h"
 #include "harness/common/options.h"
 #include "metrics/image_formats.h"
@@ -35,11 +37,32 @@ std::string valid_specs() {
     return out + ", or a path to an .exr/.hdr file";
 }
 
+// The renderers integrate radiance in 32-bit floats: a constant 1e38 overflowed the precompute's
+// sums into an all-black render that passed and could be blessed, 3e37 into NaN. The sun of
+// sky_sun is 5e4; 1e30 leaves eight orders of magnitude below float's 3.4e38 for the sums.
+constexpr float kMaxRadiance = 1e30f;
+
+std::string environment_name(const Environment& env) {
+    return "environment '" + env.spec + "'" + (env.source_path.empty() ? "" : " (" + env.source_path + ")");
+}
+
+void check_radiance(const Environment& env) {
+    const cv::Mat& m = env.equirect;
+    for (int y = 0; y < m.rows; ++y) {
+        const float* p = m.ptr<float>(y);
+        for (int i = 0; i < m.cols * 3; ++i)
+            if (!(p[i] <= kMaxRadiance))
+                throw InputError(fmt::format("{}: radiance {:g} at pixel ({}, {}) channel {} is above {:g} (the renderers' "
+                                             "float sums overflow)",
+                                             environment_name(env), p[i], i / 3, y, i % 3, kMaxRadiance));
+    }
+}
+
 void finish(Environment& env) {
+    check_radiance(env);
     if (env.equirect.cols != 2 * env.equirect.rows)
-        throw InputError("environment '" + env.spec + "'" + (env.source_path.empty() ? "" : " (" + env.source_path + ")") + ": " +
-                         std::to_string(env.equirect.cols) + "x" + std::to_string(env.equirect.rows) +
-                         " is not an equirect panorama (width must be 2 x height)");
+        throw InputError(environment_name(env) + ": " + std::to_string(env.equirect.cols) + "x" +
+                         std::to_string(env.equirect.rows) + " is not an equirect panorama (width must be 2 x height)");
     env.content_hash = fnv1a64_hex(env.equirect);
 }
 
@@ -123,7 +146,7 @@ std::string fnv1a64_hex(const cv::Mat& m) {
 
 std::vector<EnvironmentInfo> environment_catalog() {
     std::vector<EnvironmentInfo> out = {
-        {"constant:R,G,B", "Uniform radiance (also constant:V); 64x32. constant:1 is the white furnace."},
+        {"constant:R,G,B", "Uniform radiance 0..1e30 (also constant:V); 64x32. constant:1 is the white furnace."},
         {"studio", "Procedural 1024x512 studio: dim tinted backdrop (ceiling 0.1-0.2, floor 0.04-0.06) with five "
                    "rectangular area lights of radiance 9-50 (warm key front-left, cool fill, top strip, rim, kicker)."},
         {"sky_sun", "Procedural 1024x512 sky gradient (zenith 0.2,0.35,0.75 to horizon 0.75,0.8,0.9), darker ground "
@@ -134,7 +157,8 @@ std::vector<EnvironmentInfo> environment_catalog() {
         out.push_back({"blender:" + n, "Blender studio-light HDRI " + n +
                                            ".exr ($IBLCHECK_HDRI_DIR, /usr/share/blender/..., or .cache/blender-hdri "
                                            "from scripts/setup.sh)"});
-    out.push_back({"PATH.exr|PATH.hdr", "Any 2:1 equirect file; negatives clamped and counted, NaN/Inf rejected."});
+    out.push_back(
+        {"PATH.exr|PATH.hdr", "Any 2:1 equirect file; negatives clamped and counted, NaN/Inf and radiance above 1e30 rejected."});
     return out;
 }
 

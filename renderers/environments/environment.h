@@ -10,6 +10,7 @@
 // Specs: `constant:R,G,B` (or `constant:V`), `studio`, `sky_sun`, `blender:NAME` (Debian
 // blender-data's studio-light panoramas, see scripts/setup.sh), or a path to an .exr/.hdr file.
 // Files: negatives (lossy EXR has ≈ −0.004) are clamped to 0 and counted; NaN/Inf are an InputError.
+// Radiance above 1e30 (any spec) is an InputError naming the pixel: the renderers sum it in floats.
 // Sizes: constant:* is 64x32, studio and sky_sun are 1024x512 (procedural.h), files keep their size.
 // Channel order of `equirect` is R, G, B (not OpenCV's BGR), as read from the file.
 // Rotation (env_rotation): the panorama is turned by +rotation_deg about +Y (right-handed, so +90
