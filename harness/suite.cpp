@@ -227,7 +227,7 @@ struct TestEntry {
 TestEntry parse_test(const Ctx& c, const json& t, const std::string& w, const Suite& suite, const SuiteDefaults& d) {
     c.keys(t, w,
            {"scene", "method", "env", "size", "options", "variants", "baseline", "reference", "baseline_tolerances",
-            "reference_band", "tags", "temporal", "stability", "max_cost_growth", "tolerance_note"});
+            "reference_band", "tags", "temporal", "stability", "max_cost_growth", "tolerance_note", "measure_only"});
     if (t.contains("tolerance_note")) c.str(t["tolerance_note"], w + ".tolerance_note");
     if (!t.contains("scene")) c.fail(w + ".scene", "missing required key");
     if (!t.contains("method")) c.fail(w + ".method", "missing required key");
@@ -260,6 +260,7 @@ TestEntry parse_test(const Ctx& c, const json& t, const std::string& w, const Su
     if (t.contains("size")) parse_size(c, t["size"], w + ".size", proto.spec.width, proto.spec.height);
     if (t.contains("baseline")) proto.baseline = c.boolean(t["baseline"], w + ".baseline");
     if (t.contains("reference")) proto.reference = c.boolean(t["reference"], w + ".reference");
+    if (t.contains("measure_only")) proto.measure_only = c.boolean(t["measure_only"], w + ".measure_only");
     proto.baseline_tolerances = d.bounds;
     if (t.contains("baseline_tolerances"))
         for (auto& [k, v] : c.bounds(t["baseline_tolerances"], w + ".baseline_tolerances")) {
@@ -301,6 +302,26 @@ void expand_test(const Ctx& c, const TestEntry& entry, const std::string& w, std
         }
 }
 
+// Whether a test judges its image (suite.h): a bound against its baselines, the band around the
+// accuracy its baseline approved, or a temporal check. The cost alone does not.
+bool judges_image(const TestCase& tc) {
+    bool bound = false;
+    for (const auto& [metric, b] : tc.baseline_tolerances) bound |= b.min || b.max;
+    const bool temporal = tc.temporal.frames > 0 && !tc.temporal.checks.empty();
+    return (tc.baseline && bound) || (tc.baseline && tc.reference && !tc.reference_band.empty()) || temporal;
+}
+
+// A test that judges nothing passed whatever it rendered (issue 30); measure_only says so on purpose.
+void check_judges_its_image(const Ctx& c, const TestCase& tc, const std::string& w) {
+    const bool judges = judges_image(tc);
+    if (!judges && !tc.measure_only)
+        c.fail(w, tc.name + " judges nothing of its image (no baseline_tolerances bound with a baseline, no reference_band "
+                            "with a baseline, no temporal check), so any render would pass; add one, or \"measure_only\": true "
+                            "for a test that only records its figures");
+    if (judges && tc.measure_only)
+        c.fail(w + ".measure_only", tc.name + " judges its image; measure_only is for a test that only records its figures");
+}
+
 } // namespace
 
 Suite load_suite(const std::string& name_or_path) {
@@ -333,10 +354,13 @@ Suite load_suite(const std::string& name_or_path) {
 
     if (!root["tests"].is_array()) c.fail("tests", "must be an array");
     std::set<std::string> names;
+    std::vector<std::string> where; // each test's entry, for the check after every name is known
     for (size_t i = 0; i < root["tests"].size(); ++i) {
         const std::string w = "tests[" + std::to_string(i) + "]";
         expand_test(c, parse_test(c, root["tests"][i], w, suite, defaults), w, names, suite);
+        where.resize(suite.tests.size(), w);
     }
+    for (size_t k = 0; k < suite.tests.size(); ++k) check_judges_its_image(c, suite.tests[k], where[k]);
     if (suite.tests.empty()) c.fail("tests", "the suite has no tests");
     return suite;
 }

@@ -12,7 +12,7 @@
 //   "tests"*: [ { "scene"*: "roughness_sweep", "method"*: "mobile",
 //                "env": "studio" | ["studio", "sky_sun"], "size": "WxH",
 //                "options": {k: v}, "variants": [{k: v}, ...],
-//                "baseline": true, "reference": true,
+//                "baseline": true, "reference": true, "measure_only": false,
 //                "baseline_tolerances": {...}, "reference_band": {...}, "max_cost_growth": 0.25, "tags": ["..."],
 //                "tolerance_note": "why this test's tolerances differ from the defaults (measured floors)",
 //                "temporal": {"frames": 32, "reference_ssaa": 8, "reference_options": {k: v},
@@ -28,6 +28,11 @@
 // time: [v·(1 − below) − abs, v·(1 + above) + abs]; under the band is `improved`, over it `fail`.
 // max_cost_growth bounds the growth of the render's deterministic cost per pixel (executed SPIR-V
 // instructions, texture fetches) over the cost recorded with the baseline (0.25: +25 %).
+// Every test judges its image: a baseline_tolerances bound (with "baseline": true), a reference_band
+// (with a baseline, whose sidecar approved the accuracy it is built on) or a temporal check. A test
+// that judges nothing would pass any render (a shader writing vec4(0) was "improved" by its cost),
+// so it is an error in the suite unless it says "measure_only": true (its accuracy, cost and
+// timings are recorded for the charts and the history; it fails only if it cannot render).
 // timing_repeats renders each test that many times in all (1..20): the results then hold the
 // per-frame time's median and range (wall times vary 2-5x on a loaded machine; never gated).
 #pragma once
@@ -78,8 +83,9 @@ struct TestCase {
     std::string suite_arg; // what `--suite` needs to find the suite again: its name, or its path
     std::string variant;   // "default" or the canonical k=v list of all the test's options
     TestSpec spec;
-    bool baseline = true;  // compare with approved baselines
-    bool reference = true; // measure accuracy against the reference golden if one exists
+    bool baseline = true;      // compare with approved baselines
+    bool reference = true;     // measure accuracy against the reference golden (which must exist)
+    bool measure_only = false; // judges nothing of its image on purpose (suite.h's schema)
     std::map<std::string, Bound> baseline_tolerances;
     std::map<std::string, Band> reference_band;
     double max_cost_growth = 0.25; // cost per pixel (SPIR-V instructions, texture fetches) vs the baseline's
