@@ -28,10 +28,17 @@ json read_sidecar(const fs::path& exr) {
     return f ? json::parse(f, nullptr, false) : json();
 }
 
-// The accuracy against the reference golden that the reference band is built on.
-json approved_accuracy(const GoldenStore& store, const TestSpec& spec, const cv::Mat& image) {
-    auto ref = store.reference(spec);
-    if (!ref || ref->image.size() != image.size()) return json::object();
+// The accuracy against the reference golden that the reference band is built on. A test that asks
+// for the truth must have it: a golden blessed without its accuracy used to drop the check silently.
+json approved_accuracy(const GoldenStore& store, const TestCase& tc, const cv::Mat& image) {
+    if (!tc.reference) return json::object();
+    auto ref = store.reference(tc.spec);
+    if (!ref)
+        throw InputError(store.reference_path(tc.spec).string() +
+                         ": no reference golden, and the test asks for one (\"reference\": true)");
+    if (ref->image.size() != image.size())
+        throw InputError(fmt::format("{}: {}x{}, but the render is {}x{}", ref->image_path.string(), ref->image.cols,
+                                     ref->image.rows, image.cols, image.rows));
     json m = compare_images(ref->image, image, 0);
     return {{"flip.mean", m["flip"]["mean"]},
             {"flip.p99", m["flip"]["p99"]},
@@ -100,6 +107,14 @@ int bless(const BlessOptions& o) {
             ++failed;
             continue;
         }
+        json accuracy;
+        try {
+            accuracy = approved_accuracy(store, tc, rr.image);
+        } catch (const Error& e) {
+            fmt::print(stderr, "error: {}: not blessed: {}\n", tc.name, e.what());
+            ++failed;
+            continue;
+        }
         json prov = rr.provenance;
         prov["test"] = tc.name;
         prov["suite"] = tc.suite;
@@ -107,7 +122,7 @@ int bless(const BlessOptions& o) {
         prov["variant"] = tc.variant;
         prov["size"] = {rr.image.cols, rr.image.rows};
         prov["label"] = label;
-        prov["accuracy"] = approved_accuracy(store, tc.spec, rr.image);
+        prov["accuracy"] = accuracy;
         prov["cost"] = render_cost(rr);
         for (auto& [k, v] : common.items()) prov[k] = v;
         prov["command"] = bless_command(tc) + (o.label ? " --label " + label : "");

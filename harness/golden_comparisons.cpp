@@ -6,9 +6,11 @@
 #include <cstring>
 
 #include "bless.h"
+#include "harness/common/errors.h"
 #include "image_compare.h"
 #include "provenance.h"
 
+namespace fs = std::filesystem;
 using nlohmann::json;
 
 namespace iblcheck {
@@ -62,17 +64,9 @@ std::vector<Check> judge_costs(const TestCase& tc, const RenderResult& rr, const
     std::vector<Check> out;
     const json now = render_cost(rr), approved = golden.provenance.value("cost", json::object());
     for (auto& [key, value] : now.items()) {
-        if (!approved.contains(key) || !approved[key].is_number()) {
-            Check c{"cost." + key,
-                    value.get<double>(),
-                    {},
-                    {},
-                    {},
-                    Verdict::fail,
-                    "cost." + key + ": the baseline records no approved cost; re-bless it (" + bless_command(tc) + ")"};
-            out.push_back(c);
-            continue;
-        }
+        if (!approved.contains(key) || !approved[key].is_number())
+            throw InputError(fs::path(golden.image_path).replace_extension(".json").string() + ": \"cost\" has no number for \"" +
+                             key + "\" (every baseline records the cost it approved); re-create it with: " + bless_command(tc));
         out.push_back(judge_cost("cost." + key, value.get<double>(), approved[key].get<double>(), tc.max_cost_growth));
     }
     return out;

@@ -25,8 +25,8 @@ BaselineOutcome judge_against_baselines(const TestCase& tc, const RenderResult& 
                                         const Artefacts& art, int flip_threads);
 
 // The render's cost per pixel against the cost recorded with the chosen baseline, as one
-// comparison of kind "cost". A baseline without a recorded cost cannot gate it: that is a failure
-// to re-bless, not a silent pass.
+// comparison of kind "cost". A baseline whose sidecar records no cost cannot gate it: an InputError
+// naming the sidecar (exit 2, with the bless command), never a silent pass.
 Comparison cost_comparison(const TestCase& tc, const RenderResult& rr, const BaselineOutcome& base);
 
 // Accuracy against the reference golden `ref`, judged by the band around the baseline's approved

@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include "harness/common/errors.h"
+#include "metrics/image_formats.h"
 #include "metrics/image_io.h"
 
 namespace fs = std::filesystem;
@@ -36,7 +37,15 @@ Golden load_golden(const fs::path& exr, const std::string& label) {
     Golden g;
     g.image_path = exr;
     g.label = label;
-    g.image = read_image(exr.string()).pixels;
+    // A golden is what bless and truth write: an OpenEXR of R, G, B floats. A PNG named .exr or a
+    // Y-only EXR used to be compared as one (and so "fail" as a regression).
+    LoadedImage loaded = read_image(exr.string());
+    if (imagefile::sniff_format(exr.string()) != imagefile::Format::exr)
+        throw InputError(exr.string() + ": not an OpenEXR file (a golden is the float R, G, B image bless or truth wrote)");
+    if (loaded.file_channels != 3)
+        throw InputError(exr.string() + ": " + std::to_string(loaded.file_channels) +
+                         " channel(s); a golden holds R, G, B (as bless and truth write it)");
+    g.image = std::move(loaded.pixels);
     check_finite(g.image, exr.string());
     fs::path side = fs::path(exr).replace_extension(".json");
     if (!fs::exists(side))
@@ -79,6 +88,16 @@ GoldenStore::GoldenStore(fs::path root) {
             root = fs::path(IBLCHECK_SOURCE_DIR) / "goldens";
     }
     root_ = root;
+}
+
+void GoldenStore::check_root() const {
+    std::error_code ec;
+    if (!fs::is_directory(root_, ec))
+        throw InputError(root_.string() + ": " + (fs::exists(root_, ec) ? "not a folder" : "no such folder") +
+                         ": not a golden root (--goldens or IBLCHECK_GOLDEN_DIR)");
+    if (!fs::is_directory(root_ / "baseline", ec) && !fs::is_directory(root_ / "reference", ec))
+        throw InputError(root_.string() +
+                         ": no baseline/ or reference/ folder: not a golden root (--goldens or IBLCHECK_GOLDEN_DIR)");
 }
 
 std::string GoldenStore::relative(const fs::path& p) const {

@@ -31,9 +31,13 @@ class GoldenStore {
     // root: --goldens, else $IBLCHECK_GOLDEN_DIR, else <source>/goldens.
     explicit GoldenStore(std::filesystem::path root = {});
     const std::filesystem::path& root() const { return root_; }
+    // Before judging against it: the root is a folder holding baseline/ or reference/. A wrong
+    // --goldens used to make every test missing-golden (exit 1, a regression). Throws InputError.
+    void check_root() const;
 
     // All approved baselines of a test (primary first). Throws InputError naming the file on a
-    // corrupt golden, one with NaN/Inf pixels, or one without its sidecar.
+    // corrupt golden, one that is not an R, G, B OpenEXR, one with NaN/Inf pixels, or one without
+    // its sidecar.
     std::vector<Golden> baselines(const std::string& test_name) const;
     std::optional<Golden> reference(const TestSpec& spec) const;
     std::filesystem::path baseline_path(const std::string& test_name, const std::string& label = "") const;

@@ -122,6 +122,7 @@ RunSummary run_suite(const RunOptions& o) {
     std::vector<TestCase> tests = select_tests(suite, o.filter, o.shard_index, o.shard_count);
     if (tests.empty()) throw UsageError("no test in suite " + suite.name + " matches --filter '" + o.filter + "'");
     GoldenStore store(o.goldens);
+    store.check_root();
     int jobs = o.jobs > 0 ? o.jobs : suite.jobs;
     jobs = std::max(1, std::min<int>(jobs, int(tests.size())));
     OutDirLock lock(o.out_dir);

@@ -13,6 +13,7 @@
 #include "temporal_check.h"
 #include "verdict.h"
 
+namespace fs = std::filesystem;
 using nlohmann::json;
 
 namespace iblcheck {
@@ -119,11 +120,31 @@ BaselineOutcome check_baselines(TestRun& t, const RenderResult& rr) {
 // The accuracy the baseline approved (null without one): the bands of the truth and stability checks.
 json approved_accuracy(const BaselineOutcome& base) { return base.golden.provenance.value("accuracy", json()); }
 
-// Against the truth, when the store holds the scene's reference golden; returns its image (empty
-// when there is none).
+// A sidecar must carry what the test judges: a number for every metric of the reference band.
+// Missing, a string or a misspelt key used to drop the truth check silently (the test passed).
+void check_approved_accuracy(const TestRun& t, const BaselineOutcome& base) {
+    if (!t.tc.baseline || base.missing || t.tc.reference_band.empty()) return;
+    const json accuracy = approved_accuracy(base);
+    const std::string side = fs::path(base.golden.image_path).replace_extension(".json").string();
+    const std::string fix = "; re-create it with: " + bless_command(t.tc);
+    if (!accuracy.is_object())
+        throw InputError(side + ": \"accuracy\" is " + (accuracy.is_null() ? "missing" : "not an object") +
+                         " (the test's reference_band judges it)" + fix);
+    for (const auto& [metric, band] : t.tc.reference_band)
+        if (!accuracy.contains(metric) || !accuracy[metric].is_number())
+            throw InputError(side + ": \"accuracy\" has no number for \"" + metric + "\" (the test's reference_band judges it)" +
+                             fix);
+}
+
+// Against the truth: a test that asks for it ("reference": true) must have its reference golden
+// (a deleted one used to drop the check silently). Returns the golden's image.
 cv::Mat check_reference(TestRun& t, const RenderResult& rr, const BaselineOutcome& base) {
     auto ref = t.store.reference(t.tc.spec);
-    if (!ref) return {};
+    if (!ref)
+        throw InputError(t.store.reference_path(t.tc.spec).string() +
+                         ": no reference golden, and the test asks for one (\"reference\": true); create it with "
+                         "iblcheck truth (scripts/regenerate_reference_goldens.sh), or set \"reference\": false in the suite");
+    check_approved_accuracy(t, base);
     Comparison c = judge_against_truth(t.tc, rr, *ref, t.store, approved_accuracy(base), t.art, t.flip_threads, t.r);
     t.r["comparisons"].push_back(to_json(c));
     t.add(c.verdict, c.message.empty() ? "" : "accuracy: " + c.message);

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # One step of `git bisect run`: build this commit, then judge it with `iblcheck bisect`.
-# Exit 0 good, 1 bad, 125 skip (the build or the shaders do not compile).
+# Exit 0 good, 1 bad, 125 skip (the build fails, or iblcheck bisect cannot judge this commit: a
+# shader that does not compile, a usage or input error, no driver).
 #   cp -r goldens /tmp/goldens-good     # judge every commit against the same approved goldens
 #   git bisect start BAD GOOD
 #   git bisect run scripts/bisect_step.sh --goldens /tmp/goldens-good --filter 'mobile.roughness_sweep.*'

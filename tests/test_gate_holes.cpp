@@ -167,7 +167,8 @@ TEST(GateHoles, BlessLeavesUnchangedGoldensUntouchedAndPrintsOnlyAfterWriting) {
 
     // A store whose baseline folder cannot be written: an error naming it, and never "blessed".
     fs::path broken = s.dir / "broken";
-    fs::create_directories(broken / "reference");
+    fs::create_directories(broken);
+    fs::copy(s.goldens / "reference", broken / "reference", fs::copy_options::recursive); // the truth the test asks for
     std::ofstream(broken / "baseline") << "a file where the folder should be";
     EXPECT_EQ(run_command(bin("iblcheck") + " bless --suite " + s.suite.string() + " --goldens " + broken.string(), out), 2)
         << out;
@@ -229,17 +230,23 @@ TEST(GateHoles, CtestFormNeverPassesWithoutRunning) {
     const std::string ci = bin("tests/test_suite_ci");
     EXPECT_EQ(run_command(ci + " --gtest_filter=ci.no_such_test", out), 1) << out;
     EXPECT_NE(out.find("ran no test"), std::string::npos) << out;
-    EXPECT_EQ(run_command("IBLCHECK_GOLDEN_DIR=/nonexistent " + ci + " --gtest_filter=ci.mobile.furnace.constant_1.default", out),
-              1)
-        << out;
+    // A golden root with the truth the tests ask for and no baselines (a wrong root is an input
+    // error since issue 30, so it no longer stands for "no baselines").
+    const fs::path no_baselines = temp_dir("no_baselines");
+    fs::create_directories(no_baselines / "reference");
+    for (const char* f : {"furnace__constant-1", "roughness_sweep__studio"})
+        for (const char* ext : {".exr", ".json"})
+            fs::copy(fs::path(IBLCHECK_SOURCE_DIR) / "goldens/reference" / (std::string(f) + ext), no_baselines / "reference");
+    const std::string no_goldens = "IBLCHECK_GOLDEN_DIR=" + no_baselines.string() + " ";
+    EXPECT_EQ(run_command(no_goldens + ci + " --gtest_filter=ci.mobile.furnace.constant_1.default", out), 1) << out;
     EXPECT_NE(out.find("missing-golden"), std::string::npos) << out;
     EXPECT_NE(out.find("1 FAILED TEST"), std::string::npos) << out;
     // The first ci test belongs to shard 0 of 3: shard 1 reports it skipped, shard 0 runs it.
     const std::string first = " --gtest_filter=ci.mobile.roughness_sweep.studio.default";
     EXPECT_EQ(run_command("GTEST_SHARD_INDEX=1 GTEST_TOTAL_SHARDS=3 " + ci + first, out), 0) << out;
     EXPECT_NE(out.find("[  SKIPPED ] 1 test"), std::string::npos) << out;
-    EXPECT_EQ(run_command("IBLCHECK_GOLDEN_DIR=/nonexistent GTEST_SHARD_INDEX=0 GTEST_TOTAL_SHARDS=3 " + ci + first, out), 1)
-        << out;
+    EXPECT_EQ(run_command(no_goldens + "GTEST_SHARD_INDEX=0 GTEST_TOTAL_SHARDS=3 " + ci + first, out), 1) << out;
+    fs::remove_all(no_baselines);
 }
 
 TEST(GateHoles, TwiceAsMuchShadingWorkFailsOnCostAndTheFigureIsDeterministic) {

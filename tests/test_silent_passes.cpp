@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <functional>
 
 #include "harness/bless.h"
 #include "harness/common/errors.h"
@@ -20,7 +21,6 @@ using namespace iblcheck::testutil;
 using nlohmann::json;
 
 namespace {
-
 
 // The message load_suite gives for `text`, or "(loaded)".
 std::string suite_error(const fs::path& dir, const std::string& text) {
@@ -63,4 +63,134 @@ TEST(SilentPasses, ATestThatJudgesNothingIsAnErrorInTheSuite) {
             EXPECT_EQ(t.measure_only, std::string(name) == "nightly" && !t.temporal.frames) << t.name;
     }
     fs::remove_all(dir);
+}
+
+namespace {
+
+const char* kMiniSuite = R"({
+  "suite": "mini",
+  "defaults": {"env": "constant:1",
+               "baseline_tolerances": {"flip.mean": {"max": 0.001}},
+               "reference_band": {"flip.mean": {"below": 0.2, "above": 0.1}}},
+  "tests": [{"scene": "furnace", "method": "mobile"}]
+})";
+const std::string kMiniTest = "mobile.furnace.constant:1.default";
+
+// A private golden root: the furnace's reference golden and a freshly blessed baseline.
+struct Mini {
+    fs::path dir, suite, goldens;
+    explicit Mini(const std::string& name) : dir(temp_dir(name)), suite(dir / "mini.json"), goldens(dir / "goldens") {
+        write_file(suite, kMiniSuite);
+        fs::create_directories(goldens / "reference");
+        for (const char* ext : {".exr", ".json"})
+            fs::copy(fs::path(IBLCHECK_SOURCE_DIR) / (std::string("goldens/reference/furnace__constant-1") + ext),
+                     goldens / "reference");
+        BlessOptions b;
+        b.suite = suite.string();
+        b.goldens = goldens;
+        EXPECT_EQ(bless(b), kExitPass);
+    }
+    ~Mini() { fs::remove_all(dir); }
+    fs::path baseline() const { return GoldenStore(goldens).baseline_path(kMiniTest); }
+    fs::path sidecar() const { return fs::path(baseline()).replace_extension(".json"); }
+    fs::path reference() const { return goldens / "reference" / "furnace__constant-1.exr"; }
+    // The one test's verdict and message; the run's exit code in `exit_code`.
+    json run(int& exit_code) const {
+        RunOptions o;
+        o.suite = suite.string();
+        o.goldens = goldens;
+        o.quiet = true;
+        RunSummary s = run_suite(o);
+        exit_code = s.exit_code();
+        return s.results["tests"][0];
+    }
+    void edit_sidecar(const std::function<void(json&)>& edit) const {
+        json side = json::parse(read_text(sidecar()));
+        edit(side);
+        write_file(sidecar(), side.dump(2));
+    }
+    std::string cli(const std::string& args) const {
+        return std::string(IBLCHECK_BINARY_DIR) + "/iblcheck " + args + " --suite " + suite.string() + " --goldens " +
+               goldens.string();
+    }
+};
+
+// Expects the run to be an input error (verdict error, exit 2) whose message holds `what`.
+void expect_input_error(const Mini& m, const std::string& what, const std::string& why) {
+    int rc = -1;
+    const json t = m.run(rc);
+    EXPECT_EQ(t["verdict"], "error") << why << ": " << t["message"];
+    EXPECT_EQ(rc, kExitError) << why;
+    EXPECT_NE(t["message"].get<std::string>().find(what), std::string::npos) << why << ": " << t["message"];
+}
+
+} // namespace
+
+TEST(SilentPasses, ASidecarMustCarryWhatTheTestJudges) {
+    // Each of these passed with the truth check silently dropped (or, for the cost, failed as a
+    // regression): now an input error naming the sidecar and the key.
+    Mini m("sidecar_judges");
+    int rc = -1;
+    ASSERT_EQ(m.run(rc)["verdict"], "pass");
+    const json good = json::parse(read_text(m.sidecar()));
+    const std::string side = m.sidecar().string();
+    m.edit_sidecar([](json& s) { s.erase("accuracy"); });
+    expect_input_error(m, side + ": \"accuracy\" is missing (the test's reference_band judges it)", "missing");
+    m.edit_sidecar([](json& s) { s["accuracy"] = "0.12"; });
+    expect_input_error(m, side + ": \"accuracy\" is not an object", "a string");
+    m.edit_sidecar([&](json& s) { s["accuracy"] = {{"flip.maen", good["accuracy"]["flip.mean"]}}; });
+    expect_input_error(m, side + ": \"accuracy\" has no number for \"flip.mean\"", "misspelt");
+    write_file(m.sidecar(), "{}");
+    expect_input_error(m, side + ": \"cost\" has no number for", "{}");
+    write_file(m.sidecar(), good.dump(2));
+    ASSERT_EQ(m.run(rc)["verdict"], "pass");
+    // A test that asks for the truth must have its reference golden: in a run and in bless.
+    fs::remove(m.reference());
+    expect_input_error(m, m.reference().string() + ": no reference golden, and the test asks for one", "deleted reference");
+    std::string out;
+    EXPECT_EQ(run_command(m.cli("bless"), out), kExitError) << out;
+    EXPECT_NE(out.find("not blessed: " + m.reference().string() + ": no reference golden"), std::string::npos) << out;
+    EXPECT_EQ(read_text(m.sidecar()), good.dump(2)); // nothing written
+}
+
+TEST(SilentPasses, MalformedGoldenRootsAndGoldensAreInputErrors) {
+    // Each of these was exit 1, a regression (missing-golden or fail), for git bisect a bad commit.
+    Mini m("malformed_goldens");
+    RunOptions o;
+    o.suite = m.suite.string();
+    o.quiet = true;
+    for (const fs::path& root : {m.dir / "nonexistent", m.dir}) {
+        o.goldens = root;
+        try {
+            run_suite(o);
+            ADD_FAILURE() << root << " was taken for a golden root";
+        } catch (const InputError& e) {
+            EXPECT_NE(std::string(e.what()).find(root.string() + ": "), std::string::npos) << e.what();
+            EXPECT_NE(std::string(e.what()).find("not a golden root"), std::string::npos) << e.what();
+        }
+    }
+    const Golden g = GoldenStore(m.goldens).baselines(kMiniTest)[0];
+    cv::Mat y;
+    cv::extractChannel(g.image, y, 1);
+    write_exr(m.baseline().string(), y); // a Y-only golden
+    expect_input_error(m, m.baseline().string() + ": 1 channel(s); a golden holds R, G, B", "Y only");
+    write_png((m.dir / "golden.png").string(), g.image); // a PNG named .exr
+    fs::copy_file(m.dir / "golden.png", m.baseline(), fs::copy_options::overwrite_existing);
+    expect_input_error(m, m.baseline().string() + ": not an OpenEXR file", "PNG named .exr");
+}
+
+TEST(SilentPasses, BisectSaysCannotTestForAnythingButAVerdict) {
+    // git bisect run takes 1 and 2 as "bad": a filter matching nothing was 2, a wrong --goldens 1.
+    Mini m("bisect_codes");
+    std::string out;
+    EXPECT_EQ(run_command(m.cli("bisect --filter 'mobile.*'"), out), 0) << out;
+    EXPECT_EQ(run_command(m.cli("bisect --filter 'no.such.test'"), out), kExitCannotTest) << out;
+    EXPECT_NE(out.find("cannot test: no test in suite mini matches"), std::string::npos) << out;
+    EXPECT_EQ(run_command(m.cli("bisect --filter 'mobile.*'") + "/nonexistent", out), kExitCannotTest) << out;
+    EXPECT_NE(out.find("not a golden root"), std::string::npos) << out;
+    EXPECT_EQ(run_command(m.cli("bisect"), out), kExitCannotTest) << out; // --filter is required
+    EXPECT_EQ(run_command(m.cli("bisect --filter 'mobile.*' --no-such-option"), out), kExitCannotTest) << out;
+    fs::remove(m.sidecar()); // a corrupt golden store is no verdict either
+    EXPECT_EQ(run_command(m.cli("bisect --filter 'mobile.*'"), out), kExitCannotTest) << out;
+    EXPECT_NE(out.find("golden sidecar missing"), std::string::npos) << out;
 }

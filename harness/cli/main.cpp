@@ -30,7 +30,9 @@ int main(int argc, char** argv) {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
         int rc = app.exit(e);
-        return rc == 0 ? 0 : iblcheck::kExitError;
+        // `git bisect run` takes 2 as "bad": a bisect command line it cannot parse is 125 (skip).
+        const bool bisect = argc > 1 && std::string(argv[1]) == "bisect";
+        return rc == 0 ? 0 : bisect ? iblcheck::kExitCannotTest : iblcheck::kExitError;
     } catch (const iblcheck::ShaderCompileError& e) {
         fmt::print(stderr, "error: shader compile failed:\n{}\n", e.what());
         return iblcheck::kExitError;
