@@ -194,3 +194,24 @@ TEST(SilentPasses, BisectSaysCannotTestForAnythingButAVerdict) {
     EXPECT_EQ(run_command(m.cli("bisect --filter 'mobile.*'"), out), kExitCannotTest) << out;
     EXPECT_NE(out.find("golden sidecar missing"), std::string::npos) << out;
 }
+
+TEST(SilentPasses, CiSuiteLabelFailsWhenItsProgramIsNotBuilt) {
+    // After scripts/run.sh (the tool built, the test programs not), `ctest -L ci-suite` said "No
+    // tests were found!!!" and exited 0, from the root and from build/. The guard that build/tests
+    // includes adds a failing ci-suite test then; here it is pointed at a program that is absent.
+    const fs::path dir = temp_dir("ci_not_built");
+    const fs::path guard = fs::path(IBLCHECK_BINARY_DIR) / "tests" / "ci_suite_not_built.cmake";
+    write_file(dir / "CTestTestfile.cmake",
+               "set(IBLCHECK_CI_SUITE_PROGRAM \"" + (dir / "absent").string() + "\")\ninclude(\"" + guard.string() + "\")\n");
+    std::string out;
+    EXPECT_NE(run_command("cd " + dir.string() + " && " + IBLCHECK_CTEST + " -L ci-suite --output-on-failure", out), 0) << out;
+    EXPECT_NE(out.find("ci-suite.not_built"), std::string::npos) << out;
+    EXPECT_NE(out.find("(test_suite_ci) is not built: run"), std::string::npos) << out;
+    EXPECT_NE(out.find("scripts/build.sh --all"), std::string::npos) << out;
+    EXPECT_EQ(out.find("No tests were found"), std::string::npos) << out;
+    // This build has the program: the label holds the suite's tests and no guard.
+    EXPECT_EQ(run_command(std::string("cd ") + IBLCHECK_BINARY_DIR + " && " + IBLCHECK_CTEST + " -N -L ci-suite", out), 0) << out;
+    EXPECT_EQ(out.find("not_built"), std::string::npos) << out;
+    EXPECT_NE(out.find("suite.ci.mobile.roughness_sweep.studio.default"), std::string::npos) << out;
+    fs::remove_all(dir);
+}
