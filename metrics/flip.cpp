@@ -20,6 +20,8 @@
 #include <thread>
 #include <vector>
 
+#include <fmt/core.h>
+
 #include "harness/common/errors.h"
 #include "metrics/flip/color_spaces.h"
 #include "metrics/flip/csf_filters.h"
@@ -213,6 +215,19 @@ class FlipEngine {
     std::vector<Item> items_;
 };
 
+// --ppd 1e39 became inf (and 1e-39 an infinite pixel pitch): FLIP 0.0 for any pair. From 1 pixel per
+// degree the filters are at least a pixel wide; at 1000 their radius is 135 pixels (10 at 67).
+void check_ppd(double ppd, const char* what) {
+    if (!(ppd >= 1 && ppd <= 1000)) throw UsageError(fmt::format("{}: ppd {:g} is not in 1..1000 pixels per degree", what, ppd));
+}
+
+// Given exposures: 2^e must be a normal float (126 stops either way), and the range one FLIP
+// evaluation per stop (-100000..100000 ran for ever; -1e30..1e30 overflowed the exposure count).
+void check_given_exposure(float e, const char* which) {
+    if (!(std::fabs(e) <= 126.0f))
+        throw UsageError(fmt::format("HDR-FLIP: {} exposure {:g} is not in -126..126 stops", which, e));
+}
+
 void check_pair(const cv::Mat& a, const cv::Mat& b, const char* what) {
     if (a.empty() || b.empty()) throw InputError(std::string(what) + ": empty image");
     if (a.type() != CV_32FC3 || b.type() != CV_32FC3)
@@ -250,6 +265,7 @@ flip::ExposureRange lit_exposure_range(const cv::Mat& linear, flip::ToneMapper t
 
 FlipResult compute_flip_ldr(const cv::Mat& ref_srgb, const cv::Mat& test_srgb, const FlipOptions& opts) {
     check_pair(ref_srgb, test_srgb, "FLIP");
+    check_ppd(opts.ppd, "FLIP");
     const int w = ref_srgb.cols, h = ref_srgb.rows;
     const float ppd = float(opts.ppd);
     FlipResult r;
@@ -278,6 +294,9 @@ FlipResult compute_flip_ldr(const cv::Mat& ref_srgb, const cv::Mat& test_srgb, c
 
 FlipResult compute_flip_hdr(const cv::Mat& ref_linear, const cv::Mat& test_linear, const FlipOptions& opts) {
     check_pair(ref_linear, test_linear, "HDR-FLIP");
+    check_ppd(opts.ppd, "HDR-FLIP");
+    if (opts.start_exposure) check_given_exposure(*opts.start_exposure, "start");
+    if (opts.stop_exposure) check_given_exposure(*opts.stop_exposure, "stop");
     const int w = ref_linear.cols, h = ref_linear.rows;
     const float ppd = float(opts.ppd);
     FlipResult r;

@@ -239,6 +239,32 @@ TEST(Flip, AHugeFinitePixelIsScoredByEveryKernel) {
     }
 }
 
+// Issue 30's siblings: --ppd 1e39 (inf as a float) and 1e-39 scored any pair 0.0; given exposures
+// of -1e30..1e30 overflowed the exposure count, -1e5..1e5 ran for ever.
+TEST(Flip, PpdAndGivenExposuresOutsideTheirRangeAreUsageErrors) {
+    const cv::Mat a = synthetic(48, 32, 10, 0.05f), b = synthetic(48, 32, 11, 0.05f);
+    FlipOptions o;
+    for (double ppd : {1e39, 1e-39, 0.5, 1001.0}) {
+        o.ppd = ppd;
+        EXPECT_THROW(compute_flip_ldr(a, b, o), UsageError) << ppd;
+        EXPECT_THROW(compute_flip_hdr(a, b, o), UsageError) << ppd;
+    }
+    for (double ppd : {1.0, 1000.0}) {
+        o.ppd = ppd;
+        EXPECT_GT(compute_flip_ldr(a, b, o).mean, 0.01) << ppd;
+    }
+    o.ppd = flip::kDefaultPpd;
+    o.start_exposure = -1e30f;
+    o.stop_exposure = 1e30f;
+    EXPECT_THROW(compute_flip_hdr(a, b, o), UsageError);
+    o.start_exposure = std::nanf("");
+    o.stop_exposure = 1.0f;
+    EXPECT_THROW(compute_flip_hdr(a, b, o), UsageError);
+    o.start_exposure = -126.0f;
+    o.stop_exposure = 126.0f;
+    EXPECT_EQ(compute_flip_hdr(a, b, o).num_exposures, 252);
+}
+
 TEST(DisplayTransform, HugeFiniteValuesSaturateToWhite) {
     // Each used to be NaN (c * c overflows float from 1.8e19).
     const float white = display_transform_channel(1e6f); // ACES clamped to 1, then sRGB
