@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "harness/common/errors.h"
 #include "metrics/display_transform.h"
 #include "metrics/flip.h"
 #include "metrics/image_io.h"
@@ -82,17 +83,13 @@ TemporalOutcome run_temporal(const TestCase& tc, Worker& w, const GoldenStore& s
     }
     j["checks"] = json::array();
     for (auto& [metric, bound] : ts.checks) {
-        Check c;
-        if (!j.contains(metric)) { // a truth check without the truth golden
-            c.metric = "temporal." + metric;
-            c.value = std::nan("");
-            c.min = bound.min, c.max = bound.max;
-            c.status = Verdict::missing_golden;
-            c.message = "no temporal truth " + j["truth"]["missing"].get<std::string>() +
-                        " (scripts/regenerate_reference_goldens.sh writes it)";
-        } else {
-            c = judge_bound("temporal." + metric, j[metric].get<double>(), bound);
-        }
+        // A truth check without the truth golden cannot judge: an input error (exit 2, bisect 125),
+        // like a missing reference golden, not a regression.
+        if (!j.contains(metric))
+            throw InputError(store.reference_sequence_path(truth_spec, ts.frames).string() +
+                             ": no temporal truth golden, and the test's check " + metric +
+                             " judges against it (TEMPORAL=only scripts/regenerate_reference_goldens.sh writes it)");
+        Check c = judge_bound("temporal." + metric, j[metric].get<double>(), bound);
         j["checks"].push_back(to_json(c));
         out.checks.push_back(std::move(c));
     }

@@ -215,3 +215,22 @@ TEST(SilentPasses, CiSuiteLabelFailsWhenItsProgramIsNotBuilt) {
     EXPECT_NE(out.find("suite.ci.mobile.roughness_sweep.studio.default"), std::string::npos) << out;
     fs::remove_all(dir);
 }
+
+TEST(SilentPasses, ATemporalTruthCheckWithoutItsGoldenIsAnInputError) {
+    // It was missing-golden (exit 1, bisect "bad") with "approve: iblcheck bless ...", which writes
+    // nothing for a test without baselines.
+    const fs::path dir = temp_dir("temporal_truth");
+    write_file(dir / "tt.json", R"({"suite": "tt", "tests": [{"scene": "bumpy_sphere", "method": "mobile", "env": "sky_sun",
+        "size": "64x32", "baseline": false, "reference": false,
+        "temporal": {"frames": 2, "reference_ssaa": 2, "checks": {"truth_flip_mean": {"max": 1.0}}}}]})");
+    RunOptions o;
+    o.suite = (dir / "tt.json").string();
+    o.quiet = true;
+    const RunSummary s = run_suite(o);
+    const json& t = s.results["tests"][0];
+    EXPECT_EQ(t["verdict"], "error") << t["message"];
+    EXPECT_EQ(s.exit_code(), kExitError);
+    const std::string golden = GoldenStore().reference_sequence_path(load_suite(o.suite).tests[0].spec, 2).string();
+    EXPECT_NE(t["message"].get<std::string>().find(golden + ": no temporal truth golden"), std::string::npos) << t["message"];
+    fs::remove_all(dir);
+}
