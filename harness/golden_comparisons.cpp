@@ -65,8 +65,10 @@ std::vector<Check> judge_costs(const TestCase& tc, const RenderResult& rr, const
     const json now = render_cost(rr), approved = golden.provenance.value("cost", json::object());
     for (auto& [key, value] : now.items()) {
         if (!approved.contains(key) || !approved[key].is_number())
-            throw InputError(fs::path(golden.image_path).replace_extension(".json").string() + ": \"cost\" has no number for \"" +
-                             key + "\" (every baseline records the cost it approved); re-create it with: " + bless_command(tc));
+            throw InputError(fmt::format("{}: \"cost\" has no number for \"{}\" (every baseline records the cost it approved); "
+                                         "re-create it with: {}",
+                                         fs::path(golden.image_path).replace_extension(".json").string(), key,
+                                         bless_command(tc)));
         out.push_back(judge_cost("cost." + key, value.get<double>(), approved[key].get<double>(), tc.max_cost_growth));
     }
     return out;

@@ -1,5 +1,7 @@
 #include "test_run.h"
 
+#include <fmt/core.h>
+
 #include <algorithm>
 #include <chrono>
 
@@ -132,8 +134,8 @@ void check_approved_accuracy(const TestRun& t, const BaselineOutcome& base) {
                          " (the test's reference_band judges it)" + fix);
     for (const auto& [metric, band] : t.tc.reference_band)
         if (!accuracy.contains(metric) || !accuracy[metric].is_number())
-            throw InputError(side + ": \"accuracy\" has no number for \"" + metric + "\" (the test's reference_band judges it)" +
-                             fix);
+            throw InputError(fmt::format("{}: \"accuracy\" has no number for \"{}\" (the test's reference_band judges it){}",
+                                         side, metric, fix));
 }
 
 // Against the truth: a test that asks for it ("reference": true) must have its reference golden
