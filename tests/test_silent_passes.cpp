@@ -10,6 +10,7 @@
 #include "harness/bless.h"
 #include "harness/common/errors.h"
 #include "harness/golden_store.h"
+#include "harness/image_compare.h"
 #include "harness/runner.h"
 #include "harness/suite.h"
 #include "metrics/image_io.h"
@@ -233,4 +234,19 @@ TEST(SilentPasses, ATemporalTruthCheckWithoutItsGoldenIsAnInputError) {
     const std::string golden = GoldenStore().reference_sequence_path(load_suite(o.suite).tests[0].spec, 2).string();
     EXPECT_NE(t["message"].get<std::string>().find(golden + ": no temporal truth golden"), std::string::npos) << t["message"];
     fs::remove_all(dir);
+}
+
+TEST(SilentPasses, AGoldenWithAHugeFinitePixelPassesABitIdenticalRender) {
+    // The runner's and bless's comparison (image_compare.h): SSIM was NaN for a golden with one pixel
+    // at 1e20, so a bit-identical render failed it forever; against another render FLIP saw nothing.
+    const Golden g = GoldenStore().baselines("mobile.roughness_sweep.studio.default")[0];
+    cv::Mat hot = g.image.clone();
+    hot.at<cv::Vec3f>(40, 100) = cv::Vec3f(1e20f, 1e20f, 1e20f);
+    const std::map<std::string, Bound> tolerances = load_suite("ci").tests[0].baseline_tolerances;
+    const Comparison same = judge_baseline(compare_images(hot, hot, 1), tolerances);
+    EXPECT_EQ(same.verdict, Verdict::pass) << same.message;
+    EXPECT_EQ(same.metrics["ssim"]["mean"], 1.0);
+    const Comparison other = judge_baseline(compare_images(g.image, hot, 1), tolerances);
+    EXPECT_EQ(other.verdict, Verdict::fail) << other.metrics.dump();
+    EXPECT_GT(other.metrics["flip"]["max"].get<double>(), 0.5);
 }
