@@ -202,5 +202,10 @@ TEST(HostileBless, PrintedCommandsAreShellQuotedAndSelectTheirTestOnly) {
     EXPECT_TRUE(glob_match(both.substr(0, both.size() - 1), tc.name));
     EXPECT_TRUE(glob_match(both.substr(0, both.size() - 1), suite.tests[1].name));
     EXPECT_FALSE(fs::exists(dir / "PWNED"));
+    // The run's own command line (results "command", the report's Copy button) is quoted too.
+    EXPECT_EQ(shell_arg("--out"), "--out");
+    EXPECT_EQ(shell_arg(env.string()), shell_quote(env.string()));
+    EXPECT_EQ(run_command("printf '%s' " + shell_arg(env.string()), out, false), 0);
+    EXPECT_EQ(out, env.string());
     fs::remove_all(dir);
 }
