@@ -2,12 +2,19 @@
 
 #include <fmt/core.h>
 
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <regex>
 
 #include "golden_store.h"
 #include "harness/common/errors.h"
+#include "harness/common/shell_quote.h"
 #include "image_compare.h"
 #include "metrics/image_io.h"
 #include "provenance.h"
@@ -73,6 +80,63 @@ Change change_against(const fs::path& path, const cv::Mat& image, const json& pr
                               prov["accuracy"]["flip.mean"].get<double>());
     return c;
 }
+
+// One line of what bless did, flushed at once: piped into `tee` or a CI log and killed after some
+// goldens were written, the output still shows every golden written so far.
+template <typename... T> void say(FILE* to, fmt::format_string<T...> f, T&&... args) {
+    fmt::print(to, f, std::forward<T>(args)...);
+    std::fflush(to);
+}
+
+// Holds an exclusive lock on the golden folder while bless reads and writes it: two bless runs at
+// once used to both exit 0 and leave goldens of each mixed. The second waits, and says so.
+class GoldenLock {
+  public:
+    explicit GoldenLock(const fs::path& root) {
+        std::error_code ec;
+        fs::create_directories(root, ec);
+        fd_ = ::open(root.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+        if (fd_ < 0) throw InputError(root.string() + ": cannot open the golden folder: " + std::strerror(errno));
+        if (::flock(fd_, LOCK_EX | LOCK_NB) == 0) return;
+        say(stderr, "waiting: another iblcheck bless is writing into {}\n", root.string());
+        if (::flock(fd_, LOCK_EX) != 0)
+            throw InputError(root.string() + ": cannot lock the golden folder: " + std::strerror(errno));
+    }
+    ~GoldenLock() { ::close(fd_); }
+    GoldenLock(const GoldenLock&) = delete;
+    GoldenLock& operator=(const GoldenLock&) = delete;
+
+  private:
+    int fd_ = -1;
+};
+
+// The new baseline's sidecar: the render's provenance, the test, the approved accuracy and cost,
+// the run's provenance (`common`) and the command that blesses it again.
+json sidecar(const TestCase& tc, const RenderResult& rr, const GoldenStore& store, const std::optional<std::string>& label,
+             const json& common) {
+    json prov = rr.provenance;
+    prov["test"] = tc.name;
+    prov["suite"] = tc.suite;
+    prov["method"] = tc.spec.method;
+    prov["variant"] = tc.variant;
+    prov["size"] = {rr.image.cols, rr.image.rows};
+    prov["label"] = label.value_or("");
+    prov["accuracy"] = approved_accuracy(store, tc, rr.image);
+    prov["cost"] = render_cost(rr);
+    for (auto& [k, v] : common.items()) prov[k] = v;
+    prov["command"] = bless_command(tc) + (label ? " --label " + shell_quote(*label) : "");
+    return prov;
+}
+
+// A golden file already written for another test (a name that differs only where a file name
+// cannot, from another suite) is never overwritten: throws InputError naming both tests.
+void check_owner(const fs::path& path, const std::string& test) {
+    const json old = read_sidecar(path);
+    if (old.is_object() && old.contains("test") && old["test"].is_string() && old["test"] != test)
+        throw InputError(fmt::format("{}: is the baseline of test {}, not of {}; the two would share a golden (rename "
+                                     "the environment file or change an option)",
+                                     path.string(), old["test"].get<std::string>(), test));
+}
 } // namespace
 
 void check_label(const std::string& label) {
@@ -83,7 +147,7 @@ void check_label(const std::string& label) {
 
 std::string bless_command(const TestCase& t) {
     const std::string& suite = t.suite_arg.empty() ? t.suite : t.suite_arg;
-    return "iblcheck bless --suite '" + suite + "' --filter '" + t.name + "'";
+    return "iblcheck bless --suite " + shell_quote(suite) + " --filter " + shell_quote(glob_escape(t.name));
 }
 
 int bless(const BlessOptions& o) {
@@ -93,8 +157,9 @@ int bless(const BlessOptions& o) {
     std::vector<TestCase> tests = select_tests(suite, o.filter, 0, 1);
     if (tests.empty()) throw UsageError("no test in suite " + suite.name + " matches --filter '" + o.filter + "'");
     GoldenStore store(o.goldens);
+    const GoldenLock lock(store.root());
     Worker w(o.device);
-    int failed = 0;
+    int failed = 0, would = 0;
     const json common = run_provenance();
     for (const auto& tc : tests) {
         if (!tc.baseline) continue;
@@ -103,37 +168,34 @@ int bless(const BlessOptions& o) {
             rr = w.renderer.render(tc.spec);
             if (NonFinite nf = find_non_finite(rr.image); nf.count) throw NonFiniteRender(nf.describe());
         } catch (const std::exception& e) {
-            fmt::print(stderr, "error: {}: render failed, not blessed: {}\n", tc.name, e.what());
+            say(stderr, "error: {}: render failed, not blessed: {}\n", tc.name, e.what());
             ++failed;
             continue;
         }
-        json accuracy;
+        json prov;
         try {
-            accuracy = approved_accuracy(store, tc, rr.image);
+            prov = sidecar(tc, rr, store, o.label, common);
         } catch (const Error& e) {
-            fmt::print(stderr, "error: {}: not blessed: {}\n", tc.name, e.what());
+            say(stderr, "error: {}: not blessed: {}\n", tc.name, e.what());
             ++failed;
             continue;
         }
-        json prov = rr.provenance;
-        prov["test"] = tc.name;
-        prov["suite"] = tc.suite;
-        prov["method"] = tc.spec.method;
-        prov["variant"] = tc.variant;
-        prov["size"] = {rr.image.cols, rr.image.rows};
-        prov["label"] = label;
-        prov["accuracy"] = accuracy;
-        prov["cost"] = render_cost(rr);
-        for (auto& [k, v] : common.items()) prov[k] = v;
-        prov["command"] = bless_command(tc) + (o.label ? " --label " + label : "");
         const fs::path path = store.baseline_path(tc.name, label);
+        try {
+            check_owner(path, tc.name);
+        } catch (const InputError& e) {
+            say(stderr, "error: {}: not blessed: {}\n", tc.name, e.what());
+            ++failed;
+            continue;
+        }
         Change change = change_against(path, rr.image, prov);
         if (!change.pixels && !change.judged) {
-            fmt::print("{:<9} {}  (unchanged, left as it is)\n", "same", tc.name);
+            say(stdout, "{:<9} {}  (unchanged, left as it is)\n", "same", tc.name);
             continue;
         }
         if (o.dry_run) {
-            fmt::print("{:<9} {}  ({})\n", "would", tc.name, change.text);
+            say(stdout, "{:<9} {}  ({})\n", "would", tc.name, change.text);
+            ++would;
             continue;
         }
         try {
@@ -142,13 +204,17 @@ int bless(const BlessOptions& o) {
             else
                 GoldenStore::write_sidecar(path, prov);
         } catch (const std::exception& e) {
-            fmt::print(stderr, "error: {}: not blessed: {}\n", tc.name, e.what());
+            say(stderr, "error: {}: not blessed: {}\n", tc.name, e.what());
             ++failed;
             continue;
         }
-        fmt::print("{:<9} {}  ({})\n", "blessed", tc.name, change.text);
+        say(stdout, "{:<9} {}  ({})\n", "blessed", tc.name, change.text);
     }
-    return failed ? kExitError : kExitPass;
+    if (failed) return kExitError;
+    // --dry-run as a check (CI: the committed baselines are what bless writes today): 1 when
+    // anything would change, like `git diff --exit-code`.
+    if (would) say(stdout, "{} baseline(s) would change\n", would);
+    return would ? kExitRegression : kExitPass;
 }
 
 } // namespace iblcheck

@@ -46,6 +46,7 @@ void write_junit(const json& results, const fs::path& file) {
     if (!file.parent_path().empty()) fs::create_directories(file.parent_path());
     std::ofstream f(file);
     f << x;
+    f.close(); // a full disk shows at the last write, on close
     if (!f) throw InputError(file.string() + ": cannot write JUnit XML");
 }
 

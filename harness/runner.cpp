@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "harness/common/errors.h"
+#include "harness/common/output_files.h"
 #include "provenance.h"
 #include "reports/report_writer.h"
 #include "run_console.h"
@@ -34,8 +35,8 @@ struct PoolOutcome {
 
 // The tests on `jobs` worker threads, each with its own renderer, taking the next test as it
 // finishes one; a line per test as it finishes unless quiet.
-PoolOutcome run_tests(const std::vector<TestCase>& tests, const RunOptions& o, const GoldenStore& store, int jobs,
-                      int timing_repeats) {
+PoolOutcome run_tests(const std::vector<TestCase>& tests, const RunOptions& o, const fs::path& out_dir, const GoldenStore& store,
+                      int jobs, int timing_repeats) {
     const int flip_threads = jobs > 1 ? 1 : 0;
     std::vector<json> results(tests.size());
     std::atomic<size_t> next{0};
@@ -44,27 +45,35 @@ PoolOutcome run_tests(const std::vector<TestCase>& tests, const RunOptions& o, c
     std::mutex print_mutex, driver_mutex;
     json driver;
     const bool interactive = isatty(STDOUT_FILENO);
+    std::exception_ptr failure; // what stopped a worker (no device), rethrown after the join
     auto work = [&] {
-        Worker w(o.device);
-        for (size_t i; (i = next++) < tests.size();) {
-            bool se = false;
-            TestCase tc = tests[i];
-            if (o.stability) tc.stability.enabled = true;
-            results[i] = run_test(tc, w, store, o.out_dir, flip_threads, timing_repeats, se);
-            if (se) shader_error = true;
-            int n = ++done;
-            if (!o.quiet) {
-                std::lock_guard lock(print_mutex);
-                print_test_line(results[i], n, tests.size(), interactive);
+        try {
+            Worker w(o.device);
+            for (size_t i; (i = next++) < tests.size();) {
+                bool se = false;
+                TestCase tc = tests[i];
+                if (o.stability) tc.stability.enabled = true;
+                results[i] = run_test(tc, w, store, out_dir, flip_threads, timing_repeats, se);
+                if (se) shader_error = true;
+                int n = ++done;
+                if (!o.quiet) {
+                    std::lock_guard lock(print_mutex);
+                    print_test_line(results[i], n, tests.size(), interactive);
+                }
             }
+            std::lock_guard lock(driver_mutex);
+            if (json d = w.renderer.driver_json(); !d.empty()) driver = d;
+        } catch (...) { // escaping the thread, it would abort the process (SIGABRT) with no results
+            std::lock_guard lock(driver_mutex);
+            if (!failure) failure = std::current_exception();
+            next = tests.size();
         }
-        std::lock_guard lock(driver_mutex);
-        if (json d = w.renderer.driver_json(); !d.empty()) driver = d;
     };
     std::vector<std::thread> pool;
     pool.reserve(size_t(jobs));
     for (int j = 0; j < jobs; ++j) pool.emplace_back(work);
     for (auto& t : pool) t.join();
+    if (failure) std::rethrow_exception(failure);
     return {std::move(results), std::move(driver), shader_error};
 }
 
@@ -96,17 +105,37 @@ void record_run(RunSummary& s, const std::string& suite, const RunOptions& o, Po
     s.shader_compile_error = pool.shader_error;
 }
 
-// The files the options ask for: results.json, the JSON copy, JUnit, the history line, the report.
-void write_outputs(const json& R, const RunOptions& o) {
-    if (!o.out_dir.empty()) write_json_atomically(o.out_dir / "results.json", R);
+// The files the options ask for: results.json, the JSON copy, JUnit, the history line, the report;
+// the run folder is swapped in as --out once all of it is written.
+void write_outputs(const json& R, const RunOptions& o, RunFolder& folder) {
+    const fs::path& dir = folder.dir();
+    if (!dir.empty()) write_json_atomically(dir / "results.json", R);
     if (!o.json.empty()) write_json_atomically(o.json, R);
     if (!o.junit.empty()) write_junit(R, o.junit);
     std::vector<json> history;
-    if (!o.history.empty()) {
-        append_history(o.history, history_entry(R));
-        history = read_history(o.history);
+    if (!o.history.empty()) history = append_history(o.history, history_entry(R));
+    if (!dir.empty() && o.report) write_report(R, dir, dir, history);
+    folder.commit();
+}
+
+// The files named by options, checked before anything is rendered: none overwritten without
+// --force, none the same as an input, none inside --out (which is replaced whole).
+void check_output_options(const RunOptions& o, const Suite& suite) {
+    check_output_file(o.json, "--json", o.force, {suite.file, o.history});
+    check_output_file(o.junit, "--junit", o.force, {suite.file, o.history});
+    check_distinct_outputs(o.json, "--json", o.junit, "--junit");
+    if (!o.history.empty()) read_history(o.history); // a malformed history fails now, not after the renders
+    if (o.out_dir.empty()) return;
+    std::error_code ec;
+    const fs::path out = fs::weakly_canonical(fs::absolute(o.out_dir), ec);
+    const std::pair<fs::path, const char*> named[] = {{o.json, "--json"}, {o.junit, "--junit"}, {o.history, "--history"}};
+    for (const auto& [file, option] : named) {
+        if (file.empty()) continue;
+        const fs::path rel = fs::weakly_canonical(fs::absolute(file), ec).lexically_relative(out);
+        if (!rel.empty() && *rel.begin() != "..")
+            throw UsageError(std::string(option) + " " + file.string() + ": inside --out " + o.out_dir.string() +
+                             ", which each run replaces whole; give a path outside it");
     }
-    if (!o.out_dir.empty() && o.report) write_report(R, o.out_dir, o.out_dir, history);
 }
 
 } // namespace
@@ -125,13 +154,19 @@ RunSummary run_suite(const RunOptions& o) {
     store.check_root();
     int jobs = o.jobs > 0 ? o.jobs : suite.jobs;
     jobs = std::max(1, std::min<int>(jobs, int(tests.size())));
-    OutDirLock lock(o.out_dir);
+    check_output_options(o, suite);
+    RunFolder folder(o.out_dir, o.force);
 
     const auto t0 = std::chrono::steady_clock::now();
-    PoolOutcome pool = run_tests(tests, o, store, jobs, suite.timing_repeats);
+    PoolOutcome pool = run_tests(tests, o, folder.dir(), store, jobs, suite.timing_repeats);
     RunSummary s;
     record_run(s, suite.name, o, pool, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-    write_outputs(s.results, o);
+    try {
+        write_outputs(s.results, o, folder);
+    } catch (const InputError& e) { // a full disk: the run is lost, --out is not
+        throw InputError(std::string(e.what()) +
+                         (o.out_dir.empty() ? "" : "; --out " + o.out_dir.string() + " is left as it was"));
+    }
     print_run_summary(s.results, s, tests.size(), o, tests[0].suite_arg); // -q drops the per-test lines, never this summary
     return s;
 }

@@ -23,7 +23,7 @@ struct RunOptions {
     std::string filter; // glob on test names
     int shard_index = 0, shard_count = 1;
     int jobs = 0;                  // 0: the suite's default
-    std::filesystem::path out_dir; // results.json, images/, index.html; empty: no files
+    std::filesystem::path out_dir; // results.json, images/, index.html (run_files.h: RunFolder); empty: no files
     std::filesystem::path junit;   // JUnit XML
     std::filesystem::path json;    // results JSON copy
     std::filesystem::path history; // append one line per run
@@ -31,6 +31,7 @@ struct RunOptions {
     std::string device;            // Vulkan device override
     std::string command_line;      // for the report
     bool quiet = false;
+    bool force = false;     // replace an earlier run's --out, overwrite --json and --junit files
     bool report = true;     // write index.html when out_dir is set
     bool stability = false; // measure determinism, noise floors and margins for every test
 };

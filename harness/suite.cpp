@@ -2,6 +2,8 @@
 
 #include <fnmatch.h>
 
+#include <fmt/core.h>
+
 #include <cmath>
 
 #include <fstream>
@@ -9,6 +11,7 @@
 
 #include "harness/common/errors.h"
 #include "harness/common/json_check.h"
+#include "harness/golden_store.h"
 #include "renderers/option_table.h"
 #include "renderers/renderer.h"
 
@@ -142,16 +145,21 @@ std::vector<std::string> suite_names() {
 }
 
 // Several globs separated by '|' match a name when one of them does (the "approve all failures"
-// line names each failing test; test names never hold '|').
+// line names each failing test). A '|' after a backslash is part of its glob: a test name (an
+// environment file's name) may hold one, and glob_escape writes it so.
 bool glob_match(const std::string& pattern, const std::string& name) {
     if (pattern.empty()) return true;
-    for (size_t start = 0;;) {
-        const size_t end = pattern.find('|', start);
-        const std::string one = pattern.substr(start, end == std::string::npos ? std::string::npos : end - start);
-        if (fnmatch(one.c_str(), name.c_str(), 0) == 0) return true;
-        if (end == std::string::npos) return false;
-        start = end + 1;
+    std::string one;
+    for (size_t i = 0; i <= pattern.size(); ++i) {
+        if (i == pattern.size() || pattern[i] == '|') {
+            if (fnmatch(one.c_str(), name.c_str(), 0) == 0) return true;
+            one.clear();
+            continue;
+        }
+        one += pattern[i];
+        if (pattern[i] == '\\' && i + 1 < pattern.size()) one += pattern[++i];
     }
+    return false;
 }
 
 namespace {
@@ -279,17 +287,28 @@ TestEntry parse_test(const Ctx& c, const json& t, const std::string& w, const Su
     return entry;
 }
 
-// The entry's test cases (every environment × every variant), validated and uniquely named.
-void expand_test(const Ctx& c, const TestEntry& entry, const std::string& w, std::set<std::string>& names, Suite& suite) {
+// The test's variant: every option (not only the variant's) and a size other than the scene's own,
+// so two suites testing different configurations never share a name, and so never a baseline
+// golden (a suite with "size": "1x1" used to name its tests like ci's and bless over ci's goldens).
+// The size goes last and only when given: the names of the suites without one are unchanged.
+std::string variant_name(const TestSpec& spec) {
+    std::string v = spec.options.values().empty() ? "" : spec.options.canonical();
+    if (spec.width > 0) v += (v.empty() ? "" : ",") + fmt::format("size={}x{}", spec.width, spec.height);
+    return v.empty() ? "default" : v;
+}
+
+// The entry's test cases (every environment × every variant), validated and uniquely named; two
+// tests whose baselines would be the same file (names that differ only where a file name cannot,
+// e.g. "a:b" and "a-b") are refused, naming both.
+void expand_test(const Ctx& c, const TestEntry& entry, const std::string& w, std::map<std::string, std::string>& goldens,
+                 Suite& suite) {
     for (const auto& env : entry.envs)
         for (const auto& variant : entry.variants) {
             TestCase tc = entry.proto;
             tc.spec.env = env;
             tc.spec.options = entry.base_opts;
             for (auto& [k, v] : variant.values()) tc.spec.options.set(k, v);
-            // Every option is in the name (not only the variant's), so two suites testing different
-            // configurations never share a name, and so never a baseline golden.
-            tc.variant = tc.spec.options.values().empty() ? "default" : tc.spec.options.canonical();
+            tc.variant = variant_name(tc.spec);
             tc.name = tc.spec.method + "." + tc.spec.scene + "." + env + "." + tc.variant;
             try {
                 validate_spec(tc.spec);
@@ -297,7 +316,11 @@ void expand_test(const Ctx& c, const TestEntry& entry, const std::string& w, std
             } catch (const UsageError& e) {
                 c.fail(w, e.what());
             }
-            if (!names.insert(tc.name).second) c.fail(w, "duplicate test name " + tc.name);
+            const auto [it, fresh] = goldens.emplace(safe_file_name(tc.name), tc.name);
+            if (!fresh && it->second == tc.name) c.fail(w, "duplicate test name " + tc.name);
+            if (!fresh)
+                c.fail(w, "tests " + it->second + " and " + tc.name + " would share the baseline golden " + it->first +
+                              ".exr; rename an environment file or change an option so that their names differ");
             suite.tests.push_back(std::move(tc));
         }
 }
@@ -353,11 +376,11 @@ Suite load_suite(const std::string& name_or_path) {
     const SuiteDefaults defaults = parse_defaults(c, root.value("defaults", json::object()), suite);
 
     if (!root["tests"].is_array()) c.fail("tests", "must be an array");
-    std::set<std::string> names;
-    std::vector<std::string> where; // each test's entry, for the check after every name is known
+    std::map<std::string, std::string> goldens; // baseline file name -> the test that has it
+    std::vector<std::string> where;             // each test's entry, for the check after every name is known
     for (size_t i = 0; i < root["tests"].size(); ++i) {
         const std::string w = "tests[" + std::to_string(i) + "]";
-        expand_test(c, parse_test(c, root["tests"][i], w, suite, defaults), w, names, suite);
+        expand_test(c, parse_test(c, root["tests"][i], w, suite, defaults), w, goldens, suite);
         where.resize(suite.tests.size(), w);
     }
     for (size_t k = 0; k < suite.tests.size(); ++k) check_judges_its_image(c, suite.tests[k], where[k]);

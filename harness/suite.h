@@ -1,7 +1,8 @@
 // Suites are data: harness/suites/<name>.json, one schema, validated with errors that name the
 // file, the key and the problem. A suite expands into TestCases: each entry may list several
 // environments and variants, and every combination is one test named
-//   <method>.<scene>.<env>.<options>      (options: "k=v,k=v" of all the test's options, or "default")
+//   <method>.<scene>.<env>.<options>      (options: "k=v,k=v" of all the test's options, then size=WxH when the
+//                                          test gives a size; "default" when neither)
 //
 // Schema (keys marked * are required):
 // {
@@ -81,7 +82,7 @@ struct TestCase {
     std::string name;
     std::string suite;
     std::string suite_arg; // what `--suite` needs to find the suite again: its name, or its path
-    std::string variant;   // "default" or the canonical k=v list of all the test's options
+    std::string variant;   // "default", or the canonical k=v list of all the test's options then size=WxH if given
     TestSpec spec;
     bool baseline = true;      // compare with approved baselines
     bool reference = true;     // measure accuracy against the reference golden (which must exist)

@@ -205,8 +205,14 @@ json run_test(const TestCase& tc, Worker& w, const GoldenStore& store, const std
     } catch (const std::exception& e) {
         t.add(Verdict::error, e.what());
     }
-    // A test that did not pass keeps its render at full precision beside the results.
-    if (decide(t) != Verdict::pass && t.art && !image.empty()) t.art.keep_float_render(image);
+    // A test that did not pass keeps its render at full precision beside the results. This runs on a
+    // worker thread: an exception here (a full disk) used to escape it and abort the run (SIGABRT).
+    if (decide(t) != Verdict::pass && t.art && !image.empty()) try {
+            t.art.keep_float_render(image);
+        } catch (const std::exception& e) {
+            t.add(Verdict::error, e.what());
+            decide(t);
+        }
     t.r["wall_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return std::move(t.r);
 }

@@ -11,6 +11,7 @@
 
 #include "harness/common/errors.h"
 #include "harness/common/hash.h"
+#include "harness/common/output_files.h"
 #include "metrics/display_transform.h"
 #include "metrics/flip/tone_mappers.h"
 #include "metrics/image_io.h"
@@ -136,11 +137,9 @@ std::string DataStore::write(const std::string& meta_json, const std::string& pa
 }
 
 namespace {
-// Where results.json names a file: relative to its folder; absolute paths as they are.
-fs::path resolve(const fs::path& dir, const std::string& rel) {
-    fs::path p(rel);
-    return p.is_absolute() ? p : dir / p;
-}
+// Where results.json names a file: relative to its folder, and only inside it (empty otherwise:
+// no file is read).
+fs::path resolve(const fs::path& dir, const std::string& rel) { return inside_folder(dir, rel); }
 } // namespace
 
 std::optional<FloatImageInfo> DataStore::image(const std::string& exr_rel) {

@@ -1,6 +1,12 @@
 // The history file: JSON lines, one compact entry per run (reports/RESULTS_FORMAT.md, "History").
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <fstream>
 
 #include <fmt/format.h>
@@ -83,13 +89,37 @@ json history_entry(const json& results) {
     return e;
 }
 
-void append_history(const std::filesystem::path& file, const json& entry) {
+namespace {
+struct Fd {
+    int fd;
+    ~Fd() {
+        if (fd >= 0) ::close(fd);
+    }
+};
+} // namespace
+
+// Validated before anything is written (a file truncated mid-line used to get the new entry glued
+// onto its last line, and every later run then failed on it), under a lock (two runs append in
+// turn), in one write that is undone if it fails part way (a full disk).
+std::vector<json> append_history(const std::filesystem::path& file, const json& entry) {
     std::error_code ec;
     if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path(), ec);
-    std::ofstream out(file, std::ios::binary | std::ios::app);
-    if (!out) throw Error(fmt::format("{}: cannot append to the history file", file.string()));
-    out << entry.dump(-1, ' ', false, json::error_handler_t::replace) << '\n';
-    if (!out) throw Error(fmt::format("{}: write failed", file.string()));
+    const Fd f{::open(file.c_str(), O_RDWR | O_APPEND | O_CREAT | O_CLOEXEC, 0644)};
+    if (f.fd < 0 || ::flock(f.fd, LOCK_EX) != 0)
+        throw InputError(fmt::format("{}: cannot append to the history file: {}", file.string(), std::strerror(errno)));
+    std::vector<json> history = read_history(file);
+    const off_t size = ::lseek(f.fd, 0, SEEK_END);
+    char last = '\n';
+    if (size > 0 && ::pread(f.fd, &last, 1, size - 1) != 1) last = '\n';
+    // A last line without its newline that still parses is kept whole: the entry starts a line.
+    const std::string line = (last == '\n' ? "" : "\n") + entry.dump(-1, ' ', false, json::error_handler_t::replace) + "\n";
+    if (::write(f.fd, line.data(), line.size()) != ssize_t(line.size())) {
+        const int err = errno;
+        if (::ftruncate(f.fd, size) != 0) {}
+        throw InputError(fmt::format("{}: cannot append to the history file: {}", file.string(), std::strerror(err)));
+    }
+    history.push_back(entry);
+    return history;
 }
 
 } // namespace iblcheck::report

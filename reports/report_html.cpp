@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "harness/common/errors.h"
+#include "harness/common/output_files.h"
 
 namespace iblcheck::report::html {
 
@@ -116,9 +117,11 @@ std::optional<std::string> ImageStore::url(const std::string& rel) {
     if (auto it = done_.find(rel); it != done_.end()) return it->second;
     std::optional<std::string> result;
     fs::path p(rel);
-    fs::path src = p.is_absolute() ? p : results_dir_ / p;
+    const fs::path src = inside_folder(results_dir_, rel); // a tampered results file names any file
     std::error_code ec;
-    if (!fs::is_regular_file(src, ec)) {
+    if (src.empty()) {
+        missing_.push_back(rel + " (outside the run's folder: not read)");
+    } else if (!fs::is_regular_file(src, ec)) {
         missing_.push_back(rel);
     } else {
         bool clean = !p.is_absolute() && !p.empty();
@@ -140,7 +143,8 @@ std::optional<std::string> ImageStore::url(const std::string& rel) {
 
 bool ImageStore::exists(const std::string& rel) const {
     std::error_code ec;
-    return fs::is_regular_file(results_dir_ / rel, ec);
+    const fs::path src = inside_folder(results_dir_, rel);
+    return !src.empty() && fs::is_regular_file(src, ec);
 }
 
 } // namespace iblcheck::report::html

@@ -14,6 +14,7 @@
 #include <fmt/format.h>
 
 #include "harness/common/errors.h"
+#include "harness/common/shell_quote.h"
 #include "metrics/flip/magma_table.h"
 #include "metrics/flip/tone_mappers.h"
 #include "reports/drift.h"
@@ -90,10 +91,7 @@ std::string suite_arg(const std::vector<const json*>& tests) {
         size_t p = b.find("--suite ");
         if (p == std::string::npos) continue;
         p += 8;
-        const bool quoted = p < b.size() && b[p] == '\'';
-        const size_t q = quoted ? b.find('\'', p + 1) : b.find(' ', p);
-        if (quoted && q != std::string::npos) return b.substr(p + 1, q - p - 1);
-        if (!quoted) return b.substr(p, q == std::string::npos ? std::string::npos : q - p);
+        return shell_word(b, p);
     }
     return "";
 }

@@ -44,8 +44,10 @@ std::vector<nlohmann::json> read_history(const std::filesystem::path& file);
 // deterministic cost. Numbers absent from the results are left out.
 nlohmann::json history_entry(const nlohmann::json& results);
 
-// Appends `entry` as one line (creating the file and its folder).
-void append_history(const std::filesystem::path& file, const nlohmann::json& entry);
+// Appends `entry` as one line (creating the file and its folder) after read_history has validated
+// the file (InputError naming file and line: nothing is written), under a lock, in one write.
+// Returns the history with the entry.
+std::vector<nlohmann::json> append_history(const std::filesystem::path& file, const nlohmann::json& entry);
 
 } // namespace iblcheck::report
 

@@ -2,6 +2,8 @@
 
 #include <fmt/core.h>
 
+#include "harness/common/shell_quote.h"
+
 using nlohmann::json;
 
 namespace iblcheck::report {
@@ -93,12 +95,12 @@ std::string rebless_all_line(const json& tests, const std::string& suite_arg) {
     for (const json& t : tests) {
         const std::string v = str(t, "verdict");
         if (v != "fail" && v != "missing-golden") continue;
-        filter += (filter.empty() ? "" : "|") + str(t, "name");
+        filter += (filter.empty() ? "" : "|") + glob_escape(str(t, "name"));
         ++n;
     }
     if (!n) return "";
-    return fmt::format("approve all {} failure{} (after looking at them): iblcheck bless --suite '{}' --filter '{}'", n,
-                       n == 1 ? "" : "s", suite_arg, filter);
+    return fmt::format("approve all {} failure{} (after looking at them): iblcheck bless --suite {} --filter {}", n,
+                       n == 1 ? "" : "s", shell_quote(suite_arg), shell_quote(filter));
 }
 
 } // namespace iblcheck::report

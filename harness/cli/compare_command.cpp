@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "harness/common/errors.h"
+#include "harness/common/output_files.h"
 #include "metrics/flip.h"
 #include "metrics/flip_json.h"
 #include "metrics/image_io.h"
@@ -60,6 +61,9 @@ PairResult compare_pair(const CompareArgs& a) {
     if (a.mode != "auto" && a.mode != "ldr" && a.mode != "hdr")
         throw UsageError("--mode: '" + a.mode + "' is not one of auto, ldr, hdr");
     const flip::ToneMapper tm = flip::parse_tone_mapper(a.tone_mapper);
+    check_output_file(a.heatmap, "--heatmap", a.force, {a.reference, a.test});
+    check_output_file(a.errmap, "--errmap", a.force, {a.reference, a.test});
+    check_distinct_outputs(a.heatmap, "--heatmap", a.errmap, "--errmap");
 
     LoadedImage ref = read_image(a.reference);
     LoadedImage test = read_image(a.test);
@@ -271,6 +275,7 @@ void register_compare_command(CLI::App& app, int& exit_code) {
     sub->add_option("--mode", args->mode, "auto|ldr|hdr (auto: EXR/HDR -> hdr)")->check(CLI::IsMember({"auto", "ldr", "hdr"}));
     sub->add_option("--heatmap", args->heatmap, "Write the FLIP error map as a magma PNG");
     sub->add_option("--errmap", args->errmap, "Write the FLIP error map as a float EXR");
+    sub->add_flag("--force", args->force, "Overwrite an existing --heatmap/--errmap file (never REF or TEST)");
     sub->add_flag("--json", args->json, "Print one JSON object");
     sub->add_option("--ppd", args->ppd, "Pixels per degree (default 67.0206451)")->check(CLI::PositiveNumber);
     sub->add_option("--tone-mapper", args->tone_mapper, "HDR-FLIP tone mapper: aces|hable|reinhard")

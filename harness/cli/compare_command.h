@@ -17,6 +17,7 @@ struct CompareArgs {
     std::string mode = "auto";  // auto (EXR/HDR -> hdr, else ldr) | ldr | hdr
     std::string heatmap;        // PNG of the FLIP error map (magma); empty: none
     std::string errmap;         // EXR of the FLIP error map; empty: none
+    bool force = false;         // overwrite an existing heatmap / error map (never an input)
     bool json = false;
     double ppd = 0;                   // 0: FLIP's default 67.0206451
     std::string tone_mapper = "aces"; // HDR-FLIP: aces | hable | reinhard

@@ -8,6 +8,7 @@
 #include "compare_command.h"
 #include "harness/cli/version.h"
 #include "harness/common/errors.h"
+#include "harness/common/shell_quote.h"
 
 int main(int argc, char** argv) {
     CLI::App app{"iblcheck — image-diff validation harness for mobile IBL shaders"};
@@ -23,7 +24,7 @@ int main(int argc, char** argv) {
     iblcheck::cli::register_truth_command(app, exit_code);
     {
         std::string line = "iblcheck";
-        for (int i = 1; i < argc; ++i) line += std::string(" ") + argv[i];
+        for (int i = 1; i < argc; ++i) line += " " + iblcheck::shell_arg(argv[i]); // the report's Copy button pastes it
         iblcheck::cli::set_invocation(line);
     }
     try {

@@ -6,6 +6,7 @@
 
 #include "commands.h"
 #include "harness/common/errors.h"
+#include "harness/common/output_files.h"
 #include "metrics/display_transform.h"
 #include "metrics/image_io.h"
 #include "renderers/environments/environment.h"
@@ -56,8 +57,9 @@ void write_render_json(const std::string& path, const nlohmann::json& j) {
         fmt::print("{}\n", j.dump(2));
     } else {
         std::ofstream f(path);
-        if (!f) throw InputError(path + ": cannot write");
         f << j.dump(2) << "\n";
+        f.close();
+        if (!f) throw InputError(path + ": cannot write");
     }
 }
 } // namespace
@@ -92,7 +94,7 @@ void register_render_command(CLI::App& app, int& exit_code) {
     cmd->add_option("--out", out, "Output EXR (a tone-mapped PNG is written beside it)");
     cmd->add_option("--json", json_out, "Write timings and provenance as JSON to this file ('-' for stdout)");
     cmd->add_option("--device", device, "Vulkan device/driver name substring (default: lavapipe)");
-    cmd->add_flag("--force", force, "Overwrite existing output files");
+    cmd->add_flag("--force", force, "Overwrite existing output files (--out, its PNG, --json; never the --env file)");
     cmd->callback([&exit_code] {
         TestSpec spec;
         spec.scene = scene;
@@ -101,10 +103,16 @@ void register_render_command(CLI::App& app, int& exit_code) {
         parse_size(size, spec.width, spec.height);
         for (auto& s : sets) spec.options.set_from_string(s);
         namespace fs = std::filesystem;
-        fs::path png = fs::path(out).replace_extension(".png");
-        if (!out.empty() && !force)
-            for (const fs::path& p : {fs::path(out), png})
-                if (fs::exists(p)) throw UsageError(p.string() + ": exists; pass --force to overwrite");
+        const fs::path png = out.empty() ? fs::path() : fs::path(out).replace_extension(".png");
+        // The environment file is the render's input: never overwritten, not even with --force.
+        check_output_file(out, "--out", force, {env});
+        check_output_file(png, "--out (its PNG)", force, {env});
+        check_distinct_outputs(out, "--out", png, "--out's PNG"); // --out x.png
+        if (json_out != "-") {
+            check_output_file(json_out, "--json", force, {env});
+            check_distinct_outputs(json_out, "--json", out, "--out");
+            check_distinct_outputs(json_out, "--json", png, "--out's PNG");
+        }
         vk::ContextOptions vo;
         vo.device = device;
         Renderer renderer(vo);

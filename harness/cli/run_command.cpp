@@ -56,6 +56,8 @@ void register_run(CLI::App& app, int& exit_code) {
     r->add_option("--goldens", goldens, "Golden folder (default: goldens/)");
     r->add_option("--device", run.device, "Vulkan device/driver name substring (default: lavapipe)");
     r->add_flag("--quiet,-q", run.quiet, "No per-test lines (the summary line stays)");
+    r->add_flag("--force", run.force,
+                "Replace an earlier run's --out folder (whole, once this run is complete) and overwrite --json/--junit files");
     static bool list_only = false;
     r->add_flag("--list", list_only, "Print the selected tests' names and exit");
     r->add_flag("--stability", run.stability, "Also measure determinism, noise floors, sensitivity and margins");
@@ -95,7 +97,7 @@ void register_bless(CLI::App& app, int& exit_code) {
                                     "(LABEL: A-Z a-z 0-9 . _ -)");
     b->add_option("--goldens", bless_goldens, "Golden folder (default: goldens/)");
     b->add_option("--device", bo.device, "Vulkan device/driver name substring");
-    b->add_flag("--dry-run", bo.dry_run, "Show what would change, write nothing");
+    b->add_flag("--dry-run", bo.dry_run, "Show what would change, write nothing; exit 1 if anything would change");
     b->callback([&exit_code, label_opt] {
         bo.goldens = bless_goldens;
         if (label_opt->count() > 0) bo.label = label; // given, even empty: check_label refuses ""

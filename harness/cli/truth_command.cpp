@@ -17,6 +17,8 @@
 
 #include "commands.h"
 #include "harness/common/errors.h"
+#include "harness/common/output_files.h"
+#include "harness/common/shell_quote.h"
 #include "harness/golden_store.h"
 #include "renderers/reference/monte_carlo_golden.h"
 #include "renderers/reference/truth_golden.h"
@@ -64,14 +66,14 @@ struct TruthArgs {
     bool spp_given = false, seed_given = false;
 };
 
-// The golden's path (the golden store's key unless --out), refused if it or its sidecar exists without --force.
+// The golden's path (the golden store's key unless --out), refused if it or its sidecar exists without --force,
+// and always when it is an input (the --env file, or --compare's OLD.exr, which it would then be compared with).
 std::string golden_path(const TruthArgs& a, const TestSpec& keyed) {
     namespace fs = std::filesystem;
     std::string exr =
         a.out.empty() ? reference_key(keyed) + (a.frames > 0 ? "__frames=" + std::to_string(a.frames) : "") + ".exr" : a.out;
-    if (!a.force)
-        for (const fs::path& p : {fs::path(exr), fs::path(exr).replace_extension(".json")})
-            if (fs::exists(p)) throw UsageError(p.string() + ": exists; pass --force to overwrite");
+    for (const fs::path& p : {fs::path(exr), fs::path(exr).replace_extension(".json")})
+        check_output_file(p, "--out", a.force, {a.env, a.compare});
     return exr;
 }
 
@@ -79,9 +81,9 @@ std::string golden_path(const TruthArgs& a, const TestSpec& keyed) {
 // environment by its name).
 std::string recorded_command(const TruthArgs& a, const std::string& env) {
     if (!a.command.empty()) return a.command;
-    std::string c = fmt::format("iblcheck truth --scene {} --env {}", a.scene, env);
+    std::string c = fmt::format("iblcheck truth --scene {} --env {}", shell_arg(a.scene), shell_arg(env));
     if (a.integrator == "monte_carlo") c += fmt::format(" --integrator monte_carlo --spp {} --seed {}", a.spp, a.seed);
-    for (auto& s : a.sets) c += " --set " + s;
+    for (auto& s : a.sets) c += " --set " + shell_arg(s);
     if (a.frames > 0) c += " --frames " + std::to_string(a.frames);
     return c;
 }
