@@ -312,13 +312,7 @@ Suite load_suite(const std::string& name_or_path) {
         throw InputError(file.string() + ": no such suite; available: " + list);
     }
     Ctx c{file.string()};
-    json root;
-    try {
-        std::ifstream f(file);
-        root = json::parse(f);
-    } catch (const json::parse_error& e) {
-        throw InputError(file.string() + ": not valid JSON: " + e.what());
-    }
+    json root = parse_json_file(file.string()); // a folder or a FIFO: refused, not read
     c.keys(root, "(top level)", {"suite", "description", "defaults", "tests"});
     if (!root.contains("suite")) c.fail("suite", "missing required key");
     if (!root.contains("tests")) c.fail("tests", "missing required key");
