@@ -213,4 +213,16 @@ TEST_F(HostileInput, MalformedSuitesNameFilePlaceAndProblem) {
     EXPECT_EQ(suite_error("m.json", R"({"suite": "x", "tests": [)" + test + R"(}, {"options": {"ao": [1, -1e999]}}]})"),
               path("m.json") + ": tests[1].options.ao[1]: not valid JSON: [json.exception.out_of_range.406] number "
                                "overflow parsing '-1e999'");
+    EXPECT_EQ(suite_error("t.json", R"({"suite": "x", "tests": [)" + test + R"(, "tags": "abc"}]})"),
+              path("t.json") + ": tests[0].tags: must be an array of strings, not string");
+    // Counts that a double such as 1e300 does not fit (an int conversion out of range).
+    EXPECT_EQ(suite_error("j.json", R"({"suite": "x", "defaults": {"jobs": 1e300}, "tests": [)" + test + "}]}"),
+              path("j.json") + ": defaults.jobs: must be an integer in 1..1024, not 1e+300");
+    EXPECT_EQ(
+        suite_error("r.json", R"({"suite": "x", "tests": [)" + test + R"(, "temporal": {"frames": 4, "reference_ssaa": -3}}]})"),
+        path("r.json") + ": tests[0].temporal.reference_ssaa: must be an integer in 1..64, not -3");
+    // An option value above 2^63 is shown as written, not wrapped to -1.
+    EXPECT_EQ(
+        suite_error("u.json", R"({"suite": "x", "tests": [)" + test + R"(, "options": {"roughness": 18446744073709551615}}]})"),
+        path("u.json") + ": tests[0]: option 'roughness': 18446744073709551615 is outside [0, 1]");
 }
