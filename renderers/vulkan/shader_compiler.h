@@ -6,6 +6,7 @@
 // (named as the options are: DOMINANT_DIR, MIP_MAPPING, ...) or specialization constants set at
 // pipeline creation. Compiled SPIR-V is cached on disk, keyed by a hash of the source text of
 // the file and everything it includes, plus the defines, the stage and the CompileOptions.
+// Each entry carries a hash of its words: a damaged entry is compiled again and rewritten.
 #pragma once
 #include <cstdint>
 #include <filesystem>
