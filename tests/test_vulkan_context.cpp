@@ -141,7 +141,7 @@ TEST(ShaderCompiler, ACacheFileThatIsNotSpirvIsCompiledAgain) {
     setenv("IBLCHECK_CACHE_DIR", (dir / "cache").c_str(), 1);
     write_file(dir / "one.comp", "#version 460\nlayout(local_size_x = 1) in;\nvoid main() {}\n");
     auto fresh = vk::compile_compute_shader_file(dir / "one.comp");
-    fs::path cached = vk::spirv_cache_dir() / (fresh.source_hash + ".spv");
+    fs::path cached = vk::spirv_cache_entry(fresh.source_hash);
     ASSERT_TRUE(fs::exists(cached));
     write_file(cached, std::string(64, 'x'));
     auto again = vk::compile_compute_shader_file(dir / "one.comp");
@@ -165,7 +165,7 @@ void main() { if (gl_GlobalInvocationID.x < pc.n) o.v[gl_GlobalInvocationID.x] =
 )");
     const auto fresh = vk::compile_compute_shader_file(dir / "twice.comp");
     const std::string module(reinterpret_cast<const char*>(fresh.spirv.data()), fresh.spirv.size() * 4);
-    const fs::path cached = vk::spirv_cache_dir() / (fresh.source_hash + ".spv");
+    const fs::path cached = vk::spirv_cache_entry(fresh.source_hash);
     const std::string entry = read_text(cached);
     ASSERT_EQ(entry.substr(0, module.size()), module);
     vk::Context ctx({"", true});

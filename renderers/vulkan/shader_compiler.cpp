@@ -119,6 +119,8 @@ fs::path spirv_cache_dir() {
     return fs::path(IBLCHECK_SOURCE_DIR) / ".cache" / "spirv";
 }
 
+fs::path spirv_cache_entry(const std::string& source_hash) { return spirv_cache_dir() / (source_hash + ".hashed.spv"); }
+
 std::string shader_tree_hash() {
     std::vector<fs::path> files;
     fs::path dir = shader_dir();
@@ -291,7 +293,7 @@ CompiledShader compile_stage_file(const fs::path& path_in, Stage stage, const De
     CompiledShader out;
     out.source_hash = cache_key(path, stage, defines, options);
     out.counts_instructions = options.count_instructions;
-    const fs::path cached = spirv_cache_dir() / (out.source_hash + ".spv");
+    const fs::path cached = spirv_cache_entry(out.source_hash);
     if (auto spirv = read_cached(cached)) {
         out.spirv = std::move(*spirv);
         out.from_cache = true;

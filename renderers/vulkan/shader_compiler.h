@@ -57,5 +57,9 @@ std::string shader_tree_hash();
 
 // Where cached SPIR-V goes: $IBLCHECK_CACHE_DIR/spirv or <source root>/.cache/spirv.
 std::filesystem::path spirv_cache_dir();
+// The cache entry of a CompiledShader's source_hash: <key>.hashed.spv, the module followed by its
+// hash. Not <key>.spv, which commits before the hash read as a whole module (a bisect builds them
+// in the same checkout, sharing the cache).
+std::filesystem::path spirv_cache_entry(const std::string& source_hash);
 
 } // namespace iblcheck::vk
