@@ -12,6 +12,7 @@
 #include <cstring>
 #include <filesystem>
 #include <functional>
+#include <regex>
 #include <string>
 
 #include "harness/common/errors.h"
@@ -225,4 +226,42 @@ TEST_F(HostileInput, MalformedSuitesNameFilePlaceAndProblem) {
     EXPECT_EQ(
         suite_error("u.json", R"({"suite": "x", "tests": [)" + test + R"(, "options": {"roughness": 18446744073709551615}}]})"),
         path("u.json") + ": tests[0]: option 'roughness': 18446744073709551615 is outside [0, 1]");
+}
+
+// A shader that writes NaN into alpha, the coverage the texture-fetch cost is computed from. The
+// old code rendered it with exit 0 ("texture samples/px nan") and `run` blamed the cost:
+// "cost: cost.texture_fetches_per_pixel -nan (approved 2.596) is NaN". Now the shader, the channel
+// and the first pixel are named, and it is a regression (exit 1, verdict fail), on both paths.
+TEST_F(HostileInput, NanCoverageIsBlamedOnTheShaderNotTheCost) {
+    const fs::path shaders = dir_ / "nan_alpha" / "shaders";
+    fs::create_directories(shaders.parent_path());
+    fs::copy(fs::path(IBLCHECK_SOURCE_DIR) / "renderers" / "shaders", shaders, fs::copy_options::recursive);
+    const std::pair<const char*, const char*> edits[] = {
+        {"shade_spheres.comp", "return vec4(shade_surface(s, n, v, roughness), 1.0);"},
+        {"shade_spheres.frag", "color = vec4(shade_surface(s, n, v, roughness), 1.0);"}};
+    for (const auto& [file, from] : edits) {
+        std::string text = testutil::read_text(shaders / file);
+        const size_t at = text.find(from);
+        ASSERT_NE(at, std::string::npos) << file;
+        const std::string to = std::string(from).replace(std::string(from).find("1.0)"), 4, "0.0 / (roughness - roughness))");
+        testutil::write_file(shaders / file, text.replace(at, std::string(from).size(), to));
+    }
+    const std::string cli = "IBLCHECK_CACHE_DIR=" + (dir_ / "nan_alpha").string() + " IBLCHECK_SHADER_DIR=" + shaders.string() +
+                            " " + IBLCHECK_BINARY_DIR + "/iblcheck ";
+    const std::string named_re =
+        R"(alpha \(coverage\) channel: [1-9][0-9]* non-finite value\(s\) \(NaN/Inf\), first at x=\d+, y=\d+)";
+    const std::regex named(named_re);
+    std::string out;
+    EXPECT_EQ(testutil::run_command(cli + "render --scene sphere --method mobile", out), 1) << out;
+    EXPECT_TRUE(std::regex_search(out, std::regex("shade_spheres.comp: " + named_re))) << out;
+    EXPECT_EQ(testutil::run_command(cli + "render --scene sphere --method mobile --set shading=fragment", out), 1) << out;
+    EXPECT_TRUE(std::regex_search(out, std::regex("shade_spheres.frag: " + named_re))) << out;
+    const std::string json_file = (dir_ / "nan_alpha" / "r.json").string();
+    EXPECT_EQ(testutil::run_command(cli + "run --suite ci -q --filter mobile.sphere.studio.default --json " + json_file, out), 1)
+        << out;
+    const nlohmann::json t = nlohmann::json::parse(testutil::read_text(json_file))["tests"][0];
+    EXPECT_EQ(t["verdict"], "fail");
+    const std::string message = t["message"];
+    EXPECT_TRUE(std::regex_search(message, named)) << message;
+    EXPECT_EQ(message.find("cost"), std::string::npos) << message;
 }
