@@ -15,6 +15,7 @@
 #include "golden_store.h"
 #include "harness/common/errors.h"
 #include "harness/common/shell_quote.h"
+#include "harness/common/input_file.h"
 #include "image_compare.h"
 #include "metrics/image_io.h"
 #include "provenance.h"
@@ -31,8 +32,10 @@ bool bit_identical(const cv::Mat& a, const cv::Mat& b) {
 }
 
 json read_sidecar(const fs::path& exr) {
-    std::ifstream f(fs::path(exr).replace_extension(".json"));
-    return f ? json::parse(f, nullptr, false) : json();
+    const fs::path side = fs::path(exr).replace_extension(".json");
+    if (!fs::exists(side)) return json();
+    std::ifstream f = open_input_file(side.string()); // a FIFO would block: refused
+    return json::parse(f, nullptr, false);
 }
 
 // The accuracy against the reference golden that the reference band is built on. A test that asks

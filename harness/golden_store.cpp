@@ -11,6 +11,7 @@
 
 #include "harness/common/errors.h"
 #include "metrics/image_formats.h"
+#include "harness/common/input_file.h"
 #include "metrics/image_io.h"
 
 namespace fs = std::filesystem;
@@ -52,9 +53,9 @@ Golden load_golden(const fs::path& exr, const std::string& label) {
         throw InputError(side.string() + ": golden sidecar missing (every golden has one; re-create the golden with "
                                          "iblcheck bless, or scripts/regenerate_reference_goldens.sh for the truth)");
     try {
-        std::ifstream f(side);
+        std::ifstream f = open_input_file(side.string());
         g.provenance = json::parse(f);
-    } catch (const json::parse_error& e) {
+    } catch (const json::exception& e) {
         throw InputError(side.string() + ": corrupt golden sidecar: " + e.what());
     }
     if (!g.provenance.is_object()) throw InputError(side.string() + ": golden sidecar is not a JSON object");

@@ -30,6 +30,7 @@ struct Ctx : JsonChecker {
     // Option values are written as strings or numbers; both become the CLI's text form.
     std::string option_value(const json& j, const std::string& where) const {
         if (j.is_string()) return j.get<std::string>();
+        if (j.is_number_unsigned()) return std::to_string(j.get<unsigned long long>()); // above 2^63: not wrapped
         if (j.is_number_integer()) return std::to_string(j.get<long long>());
         if (j.is_number()) {
             std::string s = json(j.get<double>()).dump();
@@ -37,6 +38,13 @@ struct Ctx : JsonChecker {
         }
         if (j.is_boolean()) return j.get<bool>() ? "1" : "0";
         fail(where, "must be a string or a number");
+    }
+    // A count: a whole number in lo..hi (a double such as 1e300 would not fit an int).
+    int integer(const json& j, const std::string& where, int lo, int hi) const {
+        const double v = num(j, where);
+        if (!(v >= lo && v <= hi && v == std::floor(v)))
+            fail(where, "must be an integer in " + std::to_string(lo) + ".." + std::to_string(hi) + ", not " + j.dump());
+        return int(v);
     }
     OptionMap options(const json& j, const std::string& where) const {
         if (!j.is_object()) fail(where, "must be an object of option: value");
@@ -83,8 +91,8 @@ StabilitySpec parse_stability(const Ctx& c, const json& j, const std::string& wh
     c.keys(j, where,
            {"repeats", "seeds", "thread_counts", "roughness_bias", "camera_shift", "min_margin", "fail_on_flaky", "cpu_caps"});
     st.enabled = true;
-    if (j.contains("repeats")) st.repeats = int(c.num(j["repeats"], where + ".repeats"));
-    if (j.contains("seeds")) st.seeds = int(c.num(j["seeds"], where + ".seeds"));
+    if (j.contains("repeats")) st.repeats = c.integer(j["repeats"], where + ".repeats", 1, 1000);
+    if (j.contains("seeds")) st.seeds = c.integer(j["seeds"], where + ".seeds", 1, 1000);
     if (j.contains("thread_counts")) st.thread_counts = c.boolean(j["thread_counts"], where + ".thread_counts");
     if (j.contains("roughness_bias")) st.roughness_bias = c.num(j["roughness_bias"], where + ".roughness_bias");
     if (j.contains("camera_shift")) st.camera_shift = c.num(j["camera_shift"], where + ".camera_shift");
@@ -184,7 +192,7 @@ SuiteDefaults parse_defaults(const Ctx& c, const json& defaults, Suite& suite) {
         d.stability = parse_stability(c, defaults["stability"], "defaults.stability", d.stability);
     if (defaults.contains("env")) d.env = c.str(defaults["env"], "defaults.env");
     if (defaults.contains("size")) parse_size(c, defaults["size"], "defaults.size", d.width, d.height);
-    if (defaults.contains("jobs")) suite.jobs = int(c.num(defaults["jobs"], "defaults.jobs"));
+    if (defaults.contains("jobs")) suite.jobs = c.integer(defaults["jobs"], "defaults.jobs", 1, 1024);
     if (defaults.contains("timing_repeats")) {
         const double n = c.num(defaults["timing_repeats"], "defaults.timing_repeats");
         if (!(n >= 1 && n <= 20 && n == std::floor(n))) c.fail("defaults.timing_repeats", "must be an integer in 1..20");
@@ -201,9 +209,8 @@ TemporalSpec parse_temporal(const Ctx& c, const json& tj, const std::string& tw)
     TemporalSpec temporal;
     c.keys(tj, tw, {"frames", "reference_ssaa", "reference_options", "checks"});
     if (!tj.contains("frames")) c.fail(tw + ".frames", "missing required key");
-    temporal.frames = int(c.num(tj["frames"], tw + ".frames"));
-    if (temporal.frames < 2 || temporal.frames > 256) c.fail(tw + ".frames", "must be in 2..256");
-    if (tj.contains("reference_ssaa")) temporal.reference_ssaa = int(c.num(tj["reference_ssaa"], tw + ".reference_ssaa"));
+    temporal.frames = c.integer(tj["frames"], tw + ".frames", 2, 256);
+    if (tj.contains("reference_ssaa")) temporal.reference_ssaa = c.integer(tj["reference_ssaa"], tw + ".reference_ssaa", 1, 64);
     if (tj.contains("reference_options"))
         temporal.reference_options = c.options(tj["reference_options"], tw + ".reference_options");
     if (tj.contains("checks")) {
@@ -280,8 +287,11 @@ TestEntry parse_test(const Ctx& c, const json& t, const std::string& w, const Su
     proto.reference_band = d.bands;
     if (t.contains("reference_band"))
         for (auto& [k, v] : c.bands(t["reference_band"], w + ".reference_band")) proto.reference_band[k] = v;
-    if (t.contains("tags"))
-        for (size_t k = 0; k < t["tags"].size(); ++k) proto.tags.push_back(c.str(t["tags"][k], w + ".tags"));
+    if (t.contains("tags")) {
+        if (!t["tags"].is_array()) c.fail(w + ".tags", std::string("must be an array of strings, not ") + t["tags"].type_name());
+        for (size_t k = 0; k < t["tags"].size(); ++k)
+            proto.tags.push_back(c.str(t["tags"][k], w + ".tags[" + std::to_string(k) + "]"));
+    }
     proto.stability = t.contains("stability") ? parse_stability(c, t["stability"], w + ".stability", d.stability) : d.stability;
     if (t.contains("temporal")) proto.temporal = parse_temporal(c, t["temporal"], w + ".temporal");
     return entry;
@@ -356,13 +366,7 @@ Suite load_suite(const std::string& name_or_path) {
         throw InputError(file.string() + ": no such suite; available: " + list);
     }
     Ctx c{file.string()};
-    json root;
-    try {
-        std::ifstream f(file);
-        root = json::parse(f);
-    } catch (const json::parse_error& e) {
-        throw InputError(file.string() + ": not valid JSON: " + e.what());
-    }
+    json root = parse_json_file(file.string()); // a folder or a FIFO: refused, not read
     c.keys(root, "(top level)", {"suite", "description", "defaults", "tests"});
     if (!root.contains("suite")) c.fail("suite", "missing required key");
     if (!root.contains("tests")) c.fail("tests", "missing required key");

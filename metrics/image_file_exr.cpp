@@ -6,6 +6,8 @@
 #include <ImfOutputFile.h>
 #include <half.h>
 
+#include <algorithm>
+#include <cstdint>
 #include <exception>
 #include <memory>
 #include <vector>
@@ -26,6 +28,34 @@ std::unique_ptr<Imf::InputFile> open_exr(const std::string& path) {
         throw InputError(fmt::format("{}: cannot read image ({})", path, e.what()));
     }
 }
+
+// The largest ratio of pixel data to file bytes each compression reaches; 0 where none is known.
+double max_ratio(Imf::Compression c) {
+    switch (c) {
+    case Imf::NO_COMPRESSION: return 1;
+    case Imf::RLE_COMPRESSION: return 64; // a run of at most 128 bytes in 2
+    case Imf::ZIPS_COMPRESSION:
+    case Imf::ZIP_COMPRESSION:
+    // PIZ: Huffman codes with 8-bit run lengths, at most 256 values of 16 bits in 10 bits (410:1).
+    case Imf::PIZ_COMPRESSION: return kDeflateMaxRatio;
+    case Imf::PXR24_COMPRESSION: return kDeflateMaxRatio * 4 / 3; // 32-bit floats kept in 24 bits, then deflate
+    case Imf::B44_COMPRESSION:
+    case Imf::B44A_COMPRESSION: return 11; // a flat 4x4 block of halves (32 bytes) in 3 bytes
+    default: return 0;                     // DWAA/DWAB: a DCT, then Huffman and deflate
+    }
+}
+
+// The header's data window against the file's size, before the pixels are allocated.
+void check_claim(const std::string& path, const Imf::Header& h) {
+    double bits = 0; // per pixel, as stored before compression
+    for (auto it = h.channels().begin(); it != h.channels().end(); ++it) {
+        const Imf::Channel& ch = it.channel();
+        bits += (ch.type == Imf::HALF ? 16.0 : 32.0) / (double(std::max(ch.xSampling, 1)) * std::max(ch.ySampling, 1));
+    }
+    const Imath::Box2i dw = h.dataWindow();
+    const int64_t w = int64_t(dw.max.x) - dw.min.x + 1, hgt = int64_t(dw.max.y) - dw.min.y + 1;
+    if (w > 0 && hgt > 0) check_claimed_size(path, uint64_t(w), uint64_t(hgt), bits, max_ratio(h.compression()));
+}
 } // namespace
 
 std::optional<RawImage> read_exr(const std::string& path) {
@@ -33,6 +63,7 @@ std::optional<RawImage> read_exr(const std::string& path) {
     Imf::InputFile& in = *file;
     try {
         const Imf::Header& h = in.header();
+        check_claim(path, h);
         const Imath::Box2i dw = h.dataWindow();
         const Imf::ChannelList& cl = h.channels();
         std::vector<std::string> names;
@@ -71,6 +102,8 @@ std::optional<RawImage> read_exr(const std::string& path) {
         in.setFrameBuffer(fb);
         in.readPixels(dw.min.y, dw.max.y);
         return img;
+    } catch (const InputError&) {
+        throw;
     } catch (const std::exception& e) {
         throw InputError(fmt::format("{}: corrupt or truncated image data ({})", path, e.what()));
     }

@@ -59,10 +59,26 @@ const Plugin& plugin(const std::string& path) {
     return g_plugin;
 }
 
+// The harness's side of a read: where the pixels go, and why the header's claim was refused.
+struct ReadTarget {
+    const std::string& path;
+    const IblcheckOiioImage& image; // its width and height are set when alloc is called
+    std::vector<float>& data;
+    std::string refused;
+};
+
+// No ratio bound for the formats OpenImageIO reads (TIFF's zstd, old Radiance RLE...): the
+// claim is held to kMaxImagePixels before the buffer is allocated. nullptr tells the plugin no.
 float* alloc_into(void* ctx, size_t count) {
-    auto* v = static_cast<std::vector<float>*>(ctx);
-    v->resize(count);
-    return v->data();
+    auto* t = static_cast<ReadTarget*>(ctx);
+    try {
+        check_claimed_size(t->path, uint64_t(t->image.width), uint64_t(t->image.height), 0, 0);
+    } catch (const InputError& e) {
+        t->refused = e.what();
+        return nullptr;
+    }
+    t->data.resize(count);
+    return t->data.data();
 }
 
 } // namespace
@@ -85,9 +101,11 @@ RawImage read_with_oiio(const std::string& path, bool unassociated_alpha) {
     const Plugin& p = plugin(path);
     RawImage img;
     IblcheckOiioImage out{};
+    ReadTarget target{path, out, img.data, {}};
     out.alloc = alloc_into;
-    out.ctx = &img.data;
+    out.ctx = &target;
     const int rc = p.read(path.c_str(), unassociated_alpha ? 1 : 0, &out);
+    if (!target.refused.empty()) throw InputError(target.refused);
     const std::string why = out.error;
     if (rc == kOiioCannotOpen)
         throw InputError(fmt::format("{}: cannot read image ({})", path, why.empty() ? "unknown format or corrupt file" : why));

@@ -37,6 +37,7 @@ using File = std::unique_ptr<FILE, FileCloser>;
 struct PngInfo {
     png_uint_32 width = 0, height = 0;
     int channels = 0, bit_depth = 0;
+    int file_bits_per_pixel = 0; // as the file stores them, before the transformations
 };
 
 // Stage 1: read the header and set OpenImageIO's transformations. Returns false on a libpng error.
@@ -46,6 +47,7 @@ bool png_header(png_structp png, png_infop info, FILE* f, PngInfo* out) {
     png_read_info(png, info);
     const int color_type = png_get_color_type(png, info);
     const int depth = png_get_bit_depth(png, info);
+    out->file_bits_per_pixel = depth * png_get_channels(png, info);
     // As OpenImageIO's PNG reader (png_pvt.h): palette -> RGB, grey 1/2/4 bits -> 8 bits, tRNS ->
     // alpha; 16-bit samples are big-endian in the file.
     if (color_type == PNG_COLOR_TYPE_PALETTE) png_set_palette_to_rgb(png);
@@ -100,6 +102,8 @@ RawImage read_png(const std::string& path) {
 
     PngInfo hdr;
     if (!png_header(png, info, f.get(), &hdr)) throw InputError(fmt::format("{}: cannot read image ({})", path, err.message));
+    // Before the rows are allocated: the pixels come out of IDAT's deflate stream.
+    check_claimed_size(path, hdr.width, hdr.height, hdr.file_bits_per_pixel, kDeflateMaxRatio);
     RawImage img;
     img.width = int(hdr.width);
     img.height = int(hdr.height);

@@ -25,6 +25,20 @@ struct RawImage {
 // plugin. Throws InputError "<path>: file not found" / "is a directory" / "cannot read image (...)".
 RawImage read_raw(const std::string& path, bool unassociated_alpha);
 
+// The most pixels iblcheck reads from one image file: 2^27 (16384 x 8192, the largest HDRIs
+// published), 1.5 GiB as float RGB. A header that claims more is refused before anything is
+// allocated for it.
+inline constexpr uint64_t kMaxImagePixels = uint64_t(1) << 27;
+
+// A header's claim, checked before the reader allocates for it: throws InputError naming the file
+// and the claimed size when width x height exceeds kMaxImagePixels, or when the pixel data
+// (`stored_bits_per_pixel` each, as the format stores them before compression) is more than the
+// file's bytes can expand to at the compression's largest ratio `max_ratio` (0: no bound is known,
+// only the maximum applies). A truncated or forged header then costs nothing to refuse.
+void check_claimed_size(const std::string& path, uint64_t width, uint64_t height, double stored_bits_per_pixel, double max_ratio);
+// Deflate's largest expansion (a 258-byte match in two 1-bit codes): PNG's and OpenEXR ZIP's bound.
+inline constexpr double kDeflateMaxRatio = 1032;
+
 enum class Format { exr, png, other };
 // By the file's first bytes (the magic numbers), not its name.
 Format sniff_format(const std::string& path);

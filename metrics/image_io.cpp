@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 
 #include "harness/common/errors.h"
+#include "harness/common/input_file.h"
 #include "metrics/image_formats.h"
 
 namespace iblcheck {
@@ -30,10 +31,27 @@ Format sniff_format(const std::string& path) {
     return Format::other;
 }
 
-RawImage read_raw(const std::string& path, bool unassociated_alpha) {
+void check_claimed_size(const std::string& path, uint64_t width, uint64_t height, double stored_bits_per_pixel,
+                        double max_ratio) {
+    const uint64_t pixels = width * height; // each below 2^32: no overflow
+    if (pixels > kMaxImagePixels)
+        throw InputError(fmt::format("{}: header claims {}x{} pixels, more than iblcheck reads (at most {} pixels, e.g. "
+                                     "16384x8192)",
+                                     path, width, height, kMaxImagePixels));
     std::error_code ec;
-    if (!std::filesystem::exists(path, ec)) throw InputError(fmt::format("{}: file not found", path));
-    if (std::filesystem::is_directory(path, ec)) throw InputError(fmt::format("{}: is a directory, not an image", path));
+    const uintmax_t file_bytes = std::filesystem::file_size(path, ec);
+    if (max_ratio <= 0 || ec) return;
+    const double data_bytes = double(pixels) * stored_bits_per_pixel / 8;
+    if (data_bytes > double(file_bytes) * max_ratio)
+        throw InputError(fmt::format("{}: header claims {}x{} pixels ({:.0f} bytes of pixel data), more than its {} bytes "
+                                     "can hold at this format's largest compression ratio ({:g}:1): a corrupt or "
+                                     "truncated file",
+                                     path, width, height, data_bytes, file_bytes, max_ratio));
+}
+
+RawImage read_raw(const std::string& path, bool unassociated_alpha) {
+    // Also "file not found", and a folder: "is a folder, not a regular file".
+    require_regular_file(path);
     switch (sniff_format(path)) {
     case Format::exr:
         if (std::optional<RawImage> img = read_exr(path)) return std::move(*img);

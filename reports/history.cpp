@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 
 #include "harness/common/errors.h"
+#include "harness/common/input_file.h"
 #include "reports/report_writer.h"
 
 namespace iblcheck::report {
@@ -22,8 +23,7 @@ std::vector<json> read_history(const std::filesystem::path& file) {
     std::vector<json> out;
     std::error_code ec;
     if (!std::filesystem::exists(file, ec)) return out;
-    std::ifstream in(file, std::ios::binary);
-    if (!in) throw InputError(fmt::format("{}: cannot open the history file", file.string()));
+    std::ifstream in = open_input_file(file.string());
     std::string line;
     size_t lineno = 0;
     while (std::getline(in, line)) {
@@ -32,7 +32,7 @@ std::vector<json> read_history(const std::filesystem::path& file) {
         json j;
         try {
             j = json::parse(line);
-        } catch (const json::parse_error& e) {
+        } catch (const json::exception& e) {
             throw InputError(fmt::format("{}:{}: not a JSON line: {}", file.string(), lineno, e.what()));
         }
         if (!j.is_object() || !j.contains("tests") || !j["tests"].is_object())

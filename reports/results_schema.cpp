@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "harness/common/errors.h"
+#include "harness/common/input_file.h"
 #include "harness/common/json_check.h"
 #include "reports/report_writer.h"
 
@@ -199,14 +200,13 @@ void validate_results(const json& r, const std::string& source) {
 }
 
 json read_results(const std::filesystem::path& file) {
-    std::ifstream in(file, std::ios::binary);
-    if (!in) throw InputError(fmt::format("{}: cannot open the results file", file.string()));
+    std::ifstream in = open_input_file(file.string());
     std::stringstream ss;
     ss << in.rdbuf();
     json j;
     try {
         j = json::parse(ss.str());
-    } catch (const json::parse_error& e) {
+    } catch (const json::exception& e) { // also numbers out of range (1e400)
         throw InputError(fmt::format("{}: not valid JSON: {}", file.string(), e.what()));
     }
     validate_results(j, file.string());

@@ -141,13 +141,76 @@ TEST(ShaderCompiler, ACacheFileThatIsNotSpirvIsCompiledAgain) {
     setenv("IBLCHECK_CACHE_DIR", (dir / "cache").c_str(), 1);
     write_file(dir / "one.comp", "#version 460\nlayout(local_size_x = 1) in;\nvoid main() {}\n");
     auto fresh = vk::compile_compute_shader_file(dir / "one.comp");
-    fs::path cached = vk::spirv_cache_dir() / (fresh.source_hash + ".spv");
+    fs::path cached = vk::spirv_cache_entry(fresh.source_hash);
     ASSERT_TRUE(fs::exists(cached));
     write_file(cached, std::string(64, 'x'));
     auto again = vk::compile_compute_shader_file(dir / "one.comp");
     EXPECT_FALSE(again.from_cache);
     EXPECT_EQ(again.spirv, fresh.spirv);
     EXPECT_EQ(vk::validate_spirv(again.spirv), "");
+    fs::remove_all(dir);
+}
+
+TEST(ShaderCompiler, ADamagedCacheEntryIsCompiledAgainAndReplaced) {
+    // Issue 30: an entry with the SPIR-V header intact and damaged words behind it was used as it
+    // was: pipeline creation failed with "VkResult -13" on every run and the entry stayed; a
+    // changed constant would have rendered another image.
+    fs::path dir = temp_dir("corruptcache");
+    setenv("IBLCHECK_CACHE_DIR", (dir / "cache").c_str(), 1);
+    write_file(dir / "twice.comp", R"(#version 460
+layout(local_size_x = 64) in;
+layout(binding = 0, std430) buffer Out { float v[]; } o;
+layout(push_constant) uniform P { uint n; } pc;
+void main() { if (gl_GlobalInvocationID.x < pc.n) o.v[gl_GlobalInvocationID.x] = 2.0 * float(gl_GlobalInvocationID.x); }
+)");
+    const auto fresh = vk::compile_compute_shader_file(dir / "twice.comp");
+    const std::string module(reinterpret_cast<const char*>(fresh.spirv.data()), fresh.spirv.size() * 4);
+    const fs::path cached = vk::spirv_cache_entry(fresh.source_hash);
+    const std::string entry = read_text(cached);
+    ASSERT_EQ(entry.substr(0, module.size()), module);
+    vk::Context ctx({"", true});
+    // Only the constant 2.0 changed to 3.0; garbage behind the 5-word header.
+    std::string garbage = entry;
+    std::fill(garbage.begin() + 20, garbage.begin() + std::ptrdiff_t(module.size()), '\xab');
+    // OpConstant %float 2.0: the words 0x0004002B, type, id, 0x40000000.
+    size_t two = 0;
+    for (size_t w = 5; w + 3 < fresh.spirv.size() && !two; ++w)
+        if (fresh.spirv[w] == 0x0004002Bu && fresh.spirv[w + 3] == 0x40000000u) two = 4 * (w + 3);
+    ASSERT_NE(two, 0u);
+    std::string three = entry;
+    three[two + 2] = '\x40'; // 0x40400000: 3.0
+    for (const std::string& damaged : {three, garbage}) {
+        write_file(cached, damaged);
+        const auto again = vk::compile_compute_shader_file(dir / "twice.comp");
+        EXPECT_FALSE(again.from_cache);
+        EXPECT_EQ(again.spirv, fresh.spirv);
+        EXPECT_EQ(run_shader(ctx, again, 4)[3], 6.0f);
+        // The entry was written again: the next compile reads the whole module from it.
+        EXPECT_EQ(read_text(cached), entry);
+        EXPECT_TRUE(vk::compile_compute_shader_file(dir / "twice.comp").from_cache);
+    }
+    fs::remove_all(dir);
+}
+
+TEST(ShaderCompiler, EveryPipelineShaderIsReusedFromTheCache) {
+    // Every module the renderers compile (plain, and instrumented for the cost count) is read
+    // back whole from its entry: none is compiled again on every run.
+    fs::path dir = temp_dir("validcache");
+    setenv("IBLCHECK_CACHE_DIR", (dir / "cache").c_str(), 1);
+    const vk::Defines defaults = glsl_defines(shader_selections(OptionMap{}, "mobile"));
+    OptionMap fragment;
+    fragment.set("shading", "fragment");
+    const vk::Defines fragment_defaults = glsl_defines(shader_selections(fragment, "mobile"));
+    vk::CompileOptions counted;
+    counted.count_instructions = true;
+    for (const vk::CompileOptions& options : {vk::CompileOptions{}, counted})
+        for (const char* s :
+             {"equirect_to_cube.comp", "downsample_cube.comp", "prefilter_ggx.comp", "sh9_project.comp", "irradiance_cube.comp",
+              "dfg_lut.comp", "shade_spheres.comp", "shade_sampled.comp", "shade_spheres.vert", "shade_spheres.frag"}) {
+            const vk::Defines& d = std::string(s).find(".comp") == std::string::npos ? fragment_defaults : defaults;
+            EXPECT_FALSE(vk::compile_shader(s, d, options).from_cache) << s;
+            EXPECT_TRUE(vk::compile_shader(s, d, options).from_cache) << s << " (count: " << options.count_instructions << ")";
+        }
     fs::remove_all(dir);
 }
 

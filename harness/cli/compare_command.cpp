@@ -14,6 +14,7 @@
 
 #include "harness/common/errors.h"
 #include "harness/common/output_files.h"
+#include "harness/common/input_file.h"
 #include "metrics/flip.h"
 #include "metrics/flip_json.h"
 #include "metrics/image_io.h"
@@ -297,8 +298,7 @@ void register_compare_command(CLI::App& app, int& exit_code) {
             exit_code = run_compare_pairs(*args, std::cin, "stdin", std::cout, std::cerr);
             return;
         }
-        std::ifstream list(args->pairs);
-        if (!list) throw InputError(args->pairs + ": cannot open the list of pairs");
+        std::ifstream list = open_input_file(args->pairs);
         exit_code = run_compare_pairs(*args, list, args->pairs, std::cout, std::cerr);
     });
 }

@@ -35,7 +35,7 @@ void print_golden_sets(const std::string& driver_info) {
     };
     std::map<std::string, Set> sets;
     for (auto& e : fs::directory_iterator(dir)) {
-        if (e.path().extension() != ".json") continue;
+        if (e.path().extension() != ".json" || !e.is_regular_file()) continue; // a FIFO would block
         std::ifstream f(e.path());
         auto p = nlohmann::json::parse(f, nullptr, false);
         if (!p.is_object()) continue;

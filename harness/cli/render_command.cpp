@@ -116,7 +116,14 @@ void register_render_command(CLI::App& app, int& exit_code) {
         vk::ContextOptions vo;
         vo.device = device;
         Renderer renderer(vo);
-        RenderResult r = renderer.render(spec);
+        RenderResult r;
+        try {
+            r = renderer.render(spec);
+        } catch (const NonFiniteRender& e) { // NaN/Inf coverage: the shader's fault, a regression (exit 1)
+            fmt::print(stderr, "error: {} {} under {}: {}\n", method, scene, env, e.what());
+            exit_code = kExitRegression;
+            return;
+        }
         // With --json - the JSON owns stdout; the human-readable lines go to stderr.
         FILE* human = json_out == "-" ? stderr : stdout;
         print_render_summary(human, r);

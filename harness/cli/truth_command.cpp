@@ -19,6 +19,7 @@
 #include "harness/common/errors.h"
 #include "harness/common/output_files.h"
 #include "harness/common/shell_quote.h"
+#include "harness/common/input_file.h"
 #include "harness/golden_store.h"
 #include "renderers/reference/monte_carlo_golden.h"
 #include "renderers/reference/truth_golden.h"
@@ -106,6 +107,8 @@ void check_combinations(const TruthArgs& a) {
     if (mc && a.frames > 0) throw UsageError("--frames: the temporal truth is the quadrature's (no --integrator monte_carlo)");
     if (mc && a.spp < 1) throw UsageError("--spp: must be >= 1");
     if (!a.tiles.empty()) parse_tiles(a.tiles);
+    // Read after the render: a missing file or a FIFO is refused before the minutes it takes.
+    if (!a.compare.empty()) require_regular_file(a.compare);
 }
 
 void print_comparison(const std::string& new_exr, const std::string& old_exr) {

@@ -1,9 +1,13 @@
 #include "harness/common/json_check.h"
 
+#include <string>
+#include <vector>
+
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
 #include "harness/common/errors.h"
+#include "harness/common/input_file.h"
 
 namespace iblcheck {
 
@@ -20,7 +24,55 @@ bool has_type(const nlohmann::json& v, JsonType type) {
     return false;
 }
 
+// Where the parser is, from its callback's events: "tests[2].tags".
+class ParsePath {
+  public:
+    void on(nlohmann::json::parse_event_t event, const nlohmann::json& parsed) {
+        using E = nlohmann::json::parse_event_t;
+        switch (event) {
+        case E::object_start: frames_.push_back({false, {}, 0}); break;
+        case E::array_start: frames_.push_back({true, {}, 0}); break;
+        case E::key: frames_.back().key = parsed.get<std::string>(); break;
+        case E::object_end:
+        case E::array_end:
+            frames_.pop_back();
+            element_done();
+            break;
+        case E::value: element_done(); break;
+        }
+    }
+    std::string str() const {
+        std::string out;
+        for (const Frame& f : frames_) out += f.array ? "[" + std::to_string(f.done) + "]" : (out.empty() ? "" : ".") + f.key;
+        return out.empty() ? "(top level)" : out;
+    }
+
+  private:
+    struct Frame {
+        bool array;
+        std::string key; // objects: the key being read
+        size_t done;     // arrays: elements read, so the index of the one being read
+    };
+    void element_done() {
+        if (!frames_.empty() && frames_.back().array) ++frames_.back().done;
+    }
+    std::vector<Frame> frames_;
+};
+
 } // namespace
+
+nlohmann::json parse_json_file(const std::string& file) {
+    std::ifstream in = open_input_file(file);
+    ParsePath path;
+    try {
+        return nlohmann::json::parse(in, [&path](int, nlohmann::json::parse_event_t event, nlohmann::json& parsed) {
+            path.on(event, parsed);
+            return true;
+        });
+    } catch (const nlohmann::json::exception& e) { // parse_error, and out_of_range 406 for 1e400
+        throw InputError(fmt::format("{}: {}: not valid JSON: {}", file, path.str(), e.what()));
+    }
+}
 
 const char* JsonChecker::type_phrase(JsonType type) {
     switch (type) {

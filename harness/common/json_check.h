@@ -9,6 +9,11 @@
 
 namespace iblcheck {
 
+// Reads a JSON file that must be a regular file (input_file.h). A syntax error or a number beyond a
+// double's range (1e400) throws InputError "<file>: <where>: not valid JSON: <why>", where <where> is
+// the place the parser stopped, written as the checks below write it ("tests[0].max_cost_growth").
+nlohmann::json parse_json_file(const std::string& file);
+
 enum class JsonType { string, number, boolean, object, array };
 
 class JsonChecker {

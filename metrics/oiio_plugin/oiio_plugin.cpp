@@ -37,6 +37,7 @@ int read_image(const char* path, int unassociated_alpha, IblcheckOiioImage* out)
     if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0) return kOiioOk; // the caller refuses it
     const size_t n = size_t(spec.width) * spec.height * spec.nchannels;
     float* data = out->alloc(out->ctx, n);
+    if (!data) return kOiioReadFailed; // the caller refused the header's size (and says why)
     bool ok;
     if (out->hdr) {
         ok = in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, data);

@@ -8,7 +8,8 @@ extern "C" {
 
 struct IblcheckOiioImage {
     int width, height, channels, hdr;         // filled by the plugin
-    float* (*alloc)(void* ctx, size_t count); // the caller's buffer for width*height*channels floats
+    float* (*alloc)(void* ctx, size_t count); // the caller's buffer for width*height*channels floats, or
+                                              // nullptr: the caller refuses that size (width and height set)
     void* ctx;
     char error[1024]; // why, when the call fails
 };

@@ -133,7 +133,7 @@ std::optional<double> shade_with_compute(GpuSession& gpu, const ShadingInputs& i
     const ShadePush& pc = in.push;
     for (auto& [name, ms] : shade.dispatch_timed("shade_spheres", b, &pc, sizeof pc, (width + 7) / 8, (height + 7) / 8))
         result.timings.push_back({name, ms, true, false});
-    double coverage = read_back_image(out, width, height, result.image);
+    double coverage = read_back_image(out, width, height, result.image, "shade_spheres.comp");
     // One shading per ray that hits.
     result.texture_fetches_per_pixel = coverage * pc.ssaa * pc.ssaa * in.per_hit;
     return shading_instructions_per_pixel(

@@ -119,6 +119,8 @@ fs::path spirv_cache_dir() {
     return fs::path(IBLCHECK_SOURCE_DIR) / ".cache" / "spirv";
 }
 
+fs::path spirv_cache_entry(const std::string& source_hash) { return spirv_cache_dir() / (source_hash + ".hashed.spv"); }
+
 std::string shader_tree_hash() {
     std::vector<fs::path> files;
     fs::path dir = shader_dir();
@@ -193,16 +195,33 @@ std::string preamble_of(const Defines& defines) {
     return preamble;
 }
 
-// The module cached in `file`, if there is a whole one (a SPIR-V header at least, and whole words).
+// A cache entry is the module's words, then its FNV-1a 64 hash (two words) and this word: an
+// entry damaged on disk, even behind an intact SPIR-V header, failed only at pipeline creation
+// ("VkResult -13", or worse, a wrong image) and stayed in the cache. The hash costs ~0.1 ms per
+// read; spirv-val would cost ~15 ms per module on every run and miss a changed constant.
+constexpr uint32_t kCacheTrailer = 0x49424c43u; // "CLBI"
+constexpr size_t kTrailerWords = 3;
+
+uint64_t module_hash(const uint32_t* words, size_t count) {
+    Fnv1a64 h;
+    h.update(words, count * 4);
+    return h.value();
+}
+
+// The module cached in `file`, if there is a whole one whose hash matches (entries written
+// before the hash existed are compiled again, once).
 std::optional<std::vector<uint32_t>> read_cached(const fs::path& file) {
     std::ifstream f{file, std::ios::binary};
     if (!f) return std::nullopt;
     std::vector<char> bytes((std::istreambuf_iterator<char>(f)), {});
-    if (bytes.size() < 20 || bytes.size() % 4 != 0) return std::nullopt;
-    std::vector<uint32_t> spirv(bytes.size() / 4);
-    std::memcpy(spirv.data(), bytes.data(), bytes.size());
-    if (spirv[0] != 0x07230203u) return std::nullopt;
-    return spirv;
+    if (bytes.size() < 20 + 4 * kTrailerWords || bytes.size() % 4 != 0) return std::nullopt;
+    std::vector<uint32_t> words(bytes.size() / 4);
+    std::memcpy(words.data(), bytes.data(), bytes.size());
+    const size_t n = words.size() - kTrailerWords;
+    const uint64_t stored = words[n] | uint64_t(words[n + 1]) << 32;
+    if (words[0] != 0x07230203u || words.back() != kCacheTrailer || stored != module_hash(words.data(), n)) return std::nullopt;
+    words.resize(n);
+    return words;
 }
 
 // Write-then-rename so a concurrent reader never sees a half-written file. A cache that cannot be
@@ -214,7 +233,10 @@ void write_cached(const fs::path& file, const std::vector<uint32_t>& spirv) {
     fs::path tmp = file;
     tmp += ".tmp" + std::to_string(::getpid());
     if (std::ofstream f{tmp, std::ios::binary}) {
+        const uint64_t hash = module_hash(spirv.data(), spirv.size());
+        const uint32_t trailer[kTrailerWords] = {uint32_t(hash), uint32_t(hash >> 32), kCacheTrailer};
         f.write(reinterpret_cast<const char*>(spirv.data()), std::streamsize(spirv.size() * 4));
+        f.write(reinterpret_cast<const char*>(trailer), sizeof trailer);
         f.close();
         fs::rename(tmp, file, ec);
     }
@@ -271,7 +293,7 @@ CompiledShader compile_stage_file(const fs::path& path_in, Stage stage, const De
     CompiledShader out;
     out.source_hash = cache_key(path, stage, defines, options);
     out.counts_instructions = options.count_instructions;
-    const fs::path cached = spirv_cache_dir() / (out.source_hash + ".spv");
+    const fs::path cached = spirv_cache_entry(out.source_hash);
     if (auto spirv = read_cached(cached)) {
         out.spirv = std::move(*spirv);
         out.from_cache = true;

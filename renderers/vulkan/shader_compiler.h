@@ -6,6 +6,7 @@
 // (named as the options are: DOMINANT_DIR, MIP_MAPPING, ...) or specialization constants set at
 // pipeline creation. Compiled SPIR-V is cached on disk, keyed by a hash of the source text of
 // the file and everything it includes, plus the defines, the stage and the CompileOptions.
+// Each entry carries a hash of its words: a damaged entry is compiled again and rewritten.
 #pragma once
 #include <cstdint>
 #include <filesystem>
@@ -56,5 +57,9 @@ std::string shader_tree_hash();
 
 // Where cached SPIR-V goes: $IBLCHECK_CACHE_DIR/spirv or <source root>/.cache/spirv.
 std::filesystem::path spirv_cache_dir();
+// The cache entry of a CompiledShader's source_hash: <key>.hashed.spv, the module followed by its
+// hash. Not <key>.spv, which commits before the hash read as a whole module (a bisect builds them
+// in the same checkout, sharing the cache).
+std::filesystem::path spirv_cache_entry(const std::string& source_hash);
 
 } // namespace iblcheck::vk
