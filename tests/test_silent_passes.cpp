@@ -191,6 +191,15 @@ TEST(SilentPasses, BisectSaysCannotTestForAnythingButAVerdict) {
     EXPECT_NE(out.find("not a golden root"), std::string::npos) << out;
     EXPECT_EQ(run_command(m.cli("bisect"), out), kExitCannotTest) << out; // --filter is required
     EXPECT_EQ(run_command(m.cli("bisect --filter 'mobile.*' --no-such-option"), out), kExitCannotTest) << out;
+    const fs::path other = m.dir / "other_goldens"; // a golden root without this test's baseline
+    fs::create_directories(other);
+    fs::copy(m.goldens / "reference", other / "reference");
+    EXPECT_EQ(run_command(std::string(IBLCHECK_BINARY_DIR) + "/iblcheck bisect --filter 'mobile.*' --suite " + m.suite.string() +
+                              " --goldens " + other.string(),
+                          out),
+              kExitCannotTest)
+        << out;
+    EXPECT_NE(out.find("bisect verdict: skip (125)"), std::string::npos) << out;
     fs::remove(m.sidecar()); // a corrupt golden store is no verdict either
     EXPECT_EQ(run_command(m.cli("bisect --filter 'mobile.*'"), out), kExitCannotTest) << out;
     EXPECT_NE(out.find("golden sidecar missing"), std::string::npos) << out;

@@ -130,12 +130,14 @@ void register_bisect(CLI::App& app, int& exit_code) {
             exit_code = kExitCannotTest;
             return;
         }
-        if (sum.shader_compile_error)
+        // A test without an approved golden in --goldens cannot be judged either (a goldens folder
+        // from before the test existed made every commit "bad").
+        if (sum.shader_compile_error || sum.error)
             exit_code = kExitCannotTest;
-        else if (sum.error)
-            exit_code = kExitCannotTest;
+        else if (sum.fail)
+            exit_code = kExitRegression;
         else
-            exit_code = (sum.fail || sum.missing) ? 1 : 0;
+            exit_code = sum.missing ? kExitCannotTest : kExitPass;
         fmt::print("bisect verdict: {}\n", exit_code == 0 ? "good" : exit_code == 1 ? "bad" : "skip (125)");
     });
 }
