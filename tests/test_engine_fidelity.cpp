@@ -3,12 +3,14 @@
 // roughness the lookup assigns to it (mip 0 included); UE4's normalisation divides Luminance() of
 // the diffuse lighting by the capture's rgb mean; Lagarde's dominant direction is fed α = r²; the
 // default prefilter's noise is a small share of the error against the truth; seed 002's mip clamp;
-// RGBM's range from the source's peak, with the energy a fixed range clips.
+// RGBM's range from the source's peak, with the energy a fixed range clips; each variant's
+// white-furnace figure.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <filesystem>
 
+#include "harness/furnace_figure.h"
 #include "metrics/flip.h"
 #include "metrics/image_io.h"
 #include "renderers/environments/environment.h"
@@ -248,4 +250,32 @@ TEST(EngineFidelity, RgbmRangeIsTheSourcesPeakAndAFixedRangeReportsWhatItClips) 
     EXPECT_NEAR(p["range"].get<double>(), 50.0, 1.0);
     EXPECT_NEAR(f["clipped_energy"].get<double>(), 0.70, 0.02);
     EXPECT_TRUE(render(spec("sphere", "studio", {{"ssaa", "1"}})).provenance["rgbm"].is_null()); // not RGBM
+}
+
+TEST(EngineFidelity, EveryVariantGetsItsWhiteFurnaceFigure) {
+    // The furnace figure of a roughness-sweep test, whatever its own scene: EnvBRDFApprox
+    // (1 − 0.55 r here) against the exact albedo over each sphere's interior, measured −13.0 %,
+    // −18.0 %, −8.8 %, +16.5 % at r = 0.25, 0.5, 0.75, 1; the DFG LUT −0.29 %, +0.18 %, +0.03 %, +0.02 %.
+    Worker w("");
+    GoldenStore store;
+    auto figure = [&](const std::vector<std::pair<std::string, std::string>>& opts) {
+        TestCase tc;
+        tc.spec = spec("roughness_sweep", "studio", opts);
+        return furnace_figure(tc, w, store);
+    };
+    const nlohmann::json approx = figure({}), lut = figure({{"env_brdf", "lut"}});
+    ASSERT_TRUE(approx.is_object());
+    ASSERT_TRUE(lut.is_object());
+    EXPECT_EQ(approx["golden"], "reference/furnace__constant-1.exr");
+    EXPECT_EQ(approx["roughness"], nlohmann::json({0.25, 0.5, 0.75, 1.0}));
+    const double want[4] = {-0.130, -0.180, -0.088, 0.165};
+    for (int i = 0; i < 4; ++i) {
+        EXPECT_NEAR(approx["relative_error"][i].get<double>(), want[i], 0.01) << approx.dump();
+        EXPECT_LT(std::fabs(lut["relative_error"][i].get<double>()), 0.005) << lut.dump();
+    }
+    EXPECT_NEAR(approx["worst"].get<double>(), -0.180, 0.01);
+    TestCase truth;
+    truth.spec = spec("roughness_sweep", "studio");
+    truth.spec.method = "reference";
+    EXPECT_TRUE(furnace_figure(truth, w, store).is_null()); // the truth has none
 }
