@@ -8,6 +8,7 @@ environment, plus the row mean:
 
     scripts/variant_accuracy.py > after.txt
     scripts/variant_accuracy.py --before before.txt      # before -> after, side by side
+    scripts/variant_accuracy.py --before before.txt --after after.txt   # the same from two saved tables
 
 With --before, each cell is "before -> after" read from an earlier output of this script (rows are
 matched by variant name; a variant that is new or gone shows '-'). Run it with `nice` on a shared
@@ -118,8 +119,9 @@ def main():
     ap.add_argument("--suite", default=os.path.join(ROOT, "harness", "suites", "nightly.json"))
     ap.add_argument("--filter", help="glob on test names (a subset)")
     ap.add_argument("--before", help="an earlier output of this script: print before -> after")
+    ap.add_argument("--after", help="with --before: a saved output to compare instead of running the table")
     args = ap.parse_args()
-    if not os.access(args.iblcheck, os.X_OK):
+    if not args.after and not os.access(args.iblcheck, os.X_OK):
         fail(f"{args.iblcheck}: not an executable (build it: scripts/build.sh)")
     before = None
     if args.before:
@@ -127,7 +129,15 @@ def main():
             before, _ = read_table(args.before)
         except (OSError, ValueError, IndexError) as e:
             fail(f"{args.before}: not an output of this script ({e})")
-    table, envs = run_table(args.iblcheck, args.goldens, args.suite, args.filter)
+    if args.after:
+        if before is None:
+            fail("--after needs --before")
+        try:
+            table, envs = read_table(args.after)
+        except (OSError, ValueError, IndexError) as e:
+            fail(f"{args.after}: not an output of this script ({e})")
+    else:
+        table, envs = run_table(args.iblcheck, args.goldens, args.suite, args.filter)
     print_table(table, envs, before)
 
 
