@@ -7,6 +7,7 @@
 
 #include "artefacts.h"
 #include "bless.h"
+#include "furnace_figure.h"
 #include "golden_comparisons.h"
 #include "harness/common/errors.h"
 #include "metrics/image_io.h"
@@ -195,6 +196,7 @@ json run_test(const TestCase& tc, Worker& w, const GoldenStore& store, const std
         if (t.art) record_images(t, rr);
         const BaselineOutcome base = tc.baseline ? check_baselines(t, rr) : BaselineOutcome{};
         const cv::Mat reference = tc.reference ? check_reference(t, rr, base) : cv::Mat();
+        if (tc.reference) t.r["furnace"] = furnace_figure(tc, w, store); // energy against the white-furnace truth
         if (tc.temporal.frames > 0) check_temporal(t);
         if (tc.stability.enabled) check_stability(t, rr.image, reference, base);
     } catch (const ShaderCompileError& e) {

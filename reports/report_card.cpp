@@ -154,6 +154,21 @@ void cost_html(std::string& o, const json& t) {
     o += "</div>";
 }
 
+// The variant's white-furnace figure (harness/furnace_figure.h): its energy against the exact
+// albedo per roughness, so a reader sees which variants are energy-faithful.
+void furnace_html(std::string& o, const json& t) {
+    const json& f = sub(t, "furnace");
+    const json& rs = sub(f, "roughness");
+    const json& es = sub(f, "relative_error");
+    if (!rs.is_array() || !es.is_array() || rs.size() != es.size() || rs.empty()) return;
+    std::string cells;
+    for (size_t i = 0; i < rs.size(); ++i)
+        if (rs[i].is_number() && es[i].is_number())
+            cells += fmt::format("{}r = {}: {:+.1f} %", cells.empty() ? "" : ", ", fmt_num(rs[i].get<double>()),
+                                 100 * es[i].get<double>());
+    o += "<div class=\"meta furnace\">white furnace (energy against the exact albedo, F0 = 1): " + e(cells) + "</div>";
+}
+
 void accuracy_html(std::string& o, const json& t) {
     auto out = std::back_inserter(o);
     const json& acc = sub(t, "accuracy");
@@ -398,6 +413,7 @@ void test_card(std::string& o, const json& t, size_t idx, PageContext& ctx, cons
     o += "<div class=\"cols\">";
     cost_html(o, t);
     accuracy_html(o, t);
+    furnace_html(o, t);
     o += "</div>";
     temporal_html(o, sub(t, "temporal"), ctx.images);
     card_trend(o, trend);

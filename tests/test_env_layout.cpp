@@ -1,7 +1,8 @@
 // Layouts of the prefiltered radiance (renderers/mobile/env_layout.h; issue 18): the octahedral and
 // lat-long mappings round-trip, every border texel continues the map across its seam, the texel
 // solid angles cover the sphere, and texel counts per layout. CPU only (the GLSL twin,
-// env_layout.glsl, is held to these by the renders in test_mobile_storage_layout).
+// env_layout.glsl, is held to these by the renders in test_mobile_storage_layout). The chain's
+// length and each level's roughness (renderers/mobile/mip_chain.h; issue 27).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -9,6 +10,7 @@
 
 #include "harness/common/errors.h"
 #include "renderers/mobile/env_layout.h"
+#include "renderers/mobile/mip_chain.h"
 
 using namespace iblcheck;
 
@@ -145,4 +147,54 @@ TEST(EnvLayout, ExtentsTexelCountsAndMipLimits) {
     EXPECT_THROW(check_layout_mips(EnvLayout::octahedral, 128, 8), UsageError);
     EXPECT_NO_THROW(check_layout_mips(EnvLayout::cube, 128, 8));
     EXPECT_THROW(env_layout_from_option("sphere"), UsageError);
+}
+
+TEST(MipChain, Ue4CurveReadsCubemapMaxMipTheLastMipIndex) {
+    // UE4 passes CubemapMaxMip = FloorLog2(capture size) = 7 for 128², not the 8 mips: r = 1 is at
+    // mip 7 − 1 − 1 = 5 (4×4), mip 0 holds r = 2^(−5/1.2) ≈ 0.0561 (above FilterPS' 0.01 copy
+    // threshold, so it is filtered) and r = 0.1 reads lod 1.01. With the mip count (the old slip) r = 1
+    // was at mip 6, mip 0 at r = 2^(−6/1.2) = 0.03125 and r = 0.1 read lod 2.01: one level too coarse.
+    EXPECT_EQ(cubemap_max_mip(128), 7u);
+    EXPECT_EQ(cubemap_max_mip(8), 3u);
+    EXPECT_DOUBLE_EQ(chain_level_roughness("ue4", 5, 128, 8), 1.0);
+    EXPECT_NEAR(chain_level_roughness("ue4", 4, 128, 8), std::exp2(-1 / 1.2), 1e-12);
+    EXPECT_NEAR(chain_level_roughness("ue4", 0, 128, 8), std::exp2(-5 / 1.2), 1e-12);
+    EXPECT_NEAR(chain_roughness_lod("ue4", 0.1, 128, 8), 6 - (1 - 1.2 * std::log2(0.1)), 1e-12); // 1.014
+    EXPECT_NEAR(chain_roughness_lod("ue4", 1.0, 512, 10), 7.0, 1e-12);
+    for (double lod : {0.5, 2.0, 4.25})
+        EXPECT_NEAR(chain_roughness_lod("ue4", chain_level_roughness("ue4", lod, 128, 8), 128, 8), lod, 1e-9);
+    // Filament and the origin curve: r = 0 at mip 0, r = 1 at the last level, inverse of each other.
+    for (const char* curve : {"filament", "origin"}) {
+        EXPECT_EQ(chain_level_roughness(curve, 0, 128, 8), 0.0) << curve;
+        EXPECT_NEAR(chain_level_roughness(curve, 7, 128, 8), 1.0, 1e-9) << curve;
+        EXPECT_NEAR(chain_roughness_lod(curve, chain_level_roughness(curve, 3.5, 128, 8), 128, 8), 3.5, 1e-9) << curve;
+    }
+}
+
+TEST(MipChain, LengthFollowsTheBaseSizeAndMustReachRoughnessOne) {
+    // Default: the whole chain the layout holds, so the roughest level is r = 1 at every size.
+    EXPECT_EQ(chain_levels("ue4", EnvLayout::cube, 128, 0), 8u);
+    EXPECT_EQ(chain_levels("ue4", EnvLayout::cube, 512, 0), 10u);
+    EXPECT_EQ(chain_levels("ue4", EnvLayout::octahedral, 128, 0), 7u); // down to 4×4 (2×2 inside the border)
+    EXPECT_EQ(chain_levels("ue4", EnvLayout::equirect, 64, 0), 6u);
+    for (uint32_t size : {8u, 16u, 64u, 128u, 256u, 512u, 2048u}) {
+        const uint32_t levels = chain_levels("ue4", EnvLayout::cube, size, 0);
+        EXPECT_DOUBLE_EQ(chain_level_roughness("ue4", levels - 1, size, levels), 1.0) << size;
+    }
+    // The old fixed 7 levels: at 512² UE4's chain stopped at r = 2^(−2/1.2) ≈ 0.315 (with the mip
+    // count; 0.561 with CubemapMaxMip) and the nightly judged 512 worse than 128. Now refused.
+    EXPECT_NEAR(chain_level_roughness("ue4", 6, 512, 7), std::exp2(-1 / 1.2), 1e-12);
+    try {
+        chain_levels("ue4", EnvLayout::cube, 512, 7);
+        ADD_FAILURE() << "mips=7 at 512 accepted";
+    } catch (const UsageError& e) {
+        EXPECT_NE(std::string(e.what()).find("end at roughness 0.561, not 1"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("needs 8 to 10 levels"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(chain_levels("ue4", EnvLayout::cube, 128, 6), 6u); // r = 1 at mip 5: enough
+    EXPECT_THROW(chain_levels("ue4", EnvLayout::cube, 128, 5), UsageError);
+    EXPECT_EQ(chain_levels("filament", EnvLayout::cube, 128, 3), 3u);          // its curve ends at r = 1 by construction
+    EXPECT_THROW(chain_levels("origin", EnvLayout::cube, 128, 1), UsageError); // one level cannot hold both ends
+    EXPECT_THROW(chain_levels("ue4", EnvLayout::cube, 128, 9), UsageError);    // more than the cube holds
+    EXPECT_THROW(chain_levels("bogus", EnvLayout::cube, 128, 0), UsageError);
 }

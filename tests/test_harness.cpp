@@ -359,6 +359,10 @@ TEST(Cli, BadInputExitsTwo) {
     EXPECT_NE(out.find("astc_block"), std::string::npos) << out;
     EXPECT_EQ(run_command(iblcheck_bin() + " render --scene sphere --set env_layout=octahedral --set mips=8", out), 2);
     EXPECT_NE(out.find("mips <= 7"), std::string::npos) << out;
+    // Issue 27: a chain that stops short of r = 1 (UE4's curve reaches it at mip log2(size) − 2; the
+    // old fixed 7 levels of a 512 cube ended at r ≈ 0.31 and made 512 look worse than 128).
+    EXPECT_EQ(run_command(iblcheck_bin() + " render --scene sphere --set cube_size=512 --set mips=7", out), 2);
+    EXPECT_NE(out.find("end at roughness 0.561, not 1"), std::string::npos) << out;
     EXPECT_EQ(run_command(iblcheck_bin() + " render --scene sphere --set ao=2", out), 2);
     EXPECT_NE(out.find("'ao'"), std::string::npos) << out;
 }

@@ -95,7 +95,8 @@ TEST(OptionTable, SelectionsComeFromTheTable) {
             EXPECT_EQ(s.count(info.key), 1u) << info.key;
         }
     }
-    EXPECT_TRUE(shader_selections(o, "sampled").empty());
+    // The sampled peer's one shader option: seed 002's mip clamp (issue 27).
+    EXPECT_EQ(shader_selections(o, "sampled"), (std::map<std::string, std::string>{{"mip_clamp", "roughness"}}));
 }
 
 TEST(OptionTable, EveryNonDefaultShaderValueHasShaderCode) {

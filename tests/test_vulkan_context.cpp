@@ -216,7 +216,8 @@ TEST(ShaderCompiler, EveryPipelineShaderIsReusedFromTheCache) {
 
 TEST(ShaderCompiler, AllPipelineShadersCompile) {
     // Every pass of renderers/shaders compiles in its default variant (the option table's defaults).
-    const vk::Defines defaults = glsl_defines(shader_selections(OptionMap{}, "mobile"));
+    vk::Defines defaults = glsl_defines(shader_selections(OptionMap{}, "mobile"));
+    defaults.merge(glsl_defines(shader_selections(OptionMap{}, "sampled"))); // shade_sampled.comp's mip_clamp
     for (const char* s : {"equirect_to_cube.comp", "downsample_cube.comp", "prefilter_ggx.comp", "sh9_project.comp",
                           "irradiance_cube.comp", "dfg_lut.comp", "shade_spheres.comp", "shade_sampled.comp"}) {
         EXPECT_NO_THROW(vk::compile_compute_shader(s, defaults)) << s;

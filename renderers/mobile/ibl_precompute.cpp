@@ -1,5 +1,6 @@
 #include "ibl_precompute.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -7,6 +8,7 @@
 #include "astc_storage.h"
 #include "env_layout.h"
 #include "harness/common/errors.h"
+#include "mip_chain.h"
 #include "renderers/mobile/descriptor_types.h"
 #include "renderers/mobile/push_constants.h"
 #include "renderers/option_table.h"
@@ -18,6 +20,34 @@ namespace {
 uint32_t groups(uint32_t n, uint32_t local = 8) { return (n + local - 1) / local; }
 
 bool is_astc(const std::string& storage) { return storage == "astc_hdr" || storage == "astc_ldr_rgbm"; }
+bool is_rgbm(const std::string& storage) { return storage == "rgbm8" || storage == "astc_ldr_rgbm"; }
+
+// The RGBM range (option rgbm_range), read from the base level of the source cube, which the
+// chain's sharpest level holds: by default its peak, as UE4.26 derives a mobile capture's
+// MaxValueRGBM from the captured data (ReflectionCaptureComponent: unless bModifyMaxValueRGBM), so
+// the format's verdict is its precision over the range it needs, not an arbitrary clip; a fixed
+// range (Karis 2009: 6 in UE3's captures) is kept as asked. Either way r.rgbm_clipped_energy is the
+// share of that level's radiant energy above the range (texels weighted by their solid angle,
+// ∝ (1 + u² + v²)^(−3/2)): what the clamp loses where the reflection is sharpest.
+void fit_rgbm_range(vk::Context& ctx, const vk::Image& source, float requested, IblResources& r) {
+    const uint32_t n = source.width;
+    const std::vector<float> texels = ctx.download(source, 0);
+    float peak = 0;
+    for (size_t i = 0; i < texels.size(); i += 4) peak = std::max({peak, texels[i], texels[i + 1], texels[i + 2]});
+    r.rgbm_range = requested > 0 ? requested : std::max(peak, 1e-3f);
+    double total = 0, clipped = 0;
+    for (uint32_t face = 0; face < 6; ++face)
+        for (uint32_t y = 0; y < n; ++y)
+            for (uint32_t x = 0; x < n; ++x) {
+                const double u = (x + 0.5) / n * 2 - 1, v = (y + 0.5) / n * 2 - 1, w = std::pow(1 + u * u + v * v, -1.5);
+                const float* c = &texels[4 * ((size_t(face) * n + y) * n + x)];
+                for (int k = 0; k < 3; ++k) {
+                    total += w * c[k];
+                    clipped += w * std::max(0.0, double(c[k]) - r.rgbm_range);
+                }
+            }
+    r.rgbm_clipped_energy = total > 0 ? clipped / total : 0.0;
+}
 
 VkFormat storage_format(const std::string& storage, bool native_r11g11b10) {
     if (storage == "rgba32f") return VK_FORMAT_R32G32B32A32_SFLOAT;
@@ -33,12 +63,12 @@ VkFormat storage_format(const std::string& storage, bool native_r11g11b10) {
 // Every level of every layer of `encoded` (RGBA32F, as the prefilter pass wrote it) through the
 // ASTC codec; returns the decoded texels in an RGBA16F image of the same shape, which the shading
 // pass samples. The encode and decode times are precompute passes (on the CPU).
-vk::Image astc_round_trip(vk::Context& ctx, const vk::Image& encoded, const PrecomputeSettings& s,
+vk::Image astc_round_trip(vk::Context& ctx, const vk::Image& encoded, const PrecomputeSettings& s, float rgbm_range,
                           std::vector<PassTiming>& timings) {
     AstcFormat format;
     format.profile = s.storage == "astc_hdr" ? AstcProfile::hdr : AstcProfile::ldr_rgbm;
     format.block = astc_block_from_option(s.astc_block);
-    format.rgbm_range = s.rgbm_range;
+    format.rgbm_range = rgbm_range;
     AstcCodec codec(format);
     vk::Image decoded =
         ctx.create_image(VK_FORMAT_R16G16B16A16_SFLOAT, encoded.width, encoded.height, encoded.mips, encoded.cube);
@@ -79,10 +109,10 @@ uint64_t storage_level_bytes(const std::string& storage, const std::string& astc
     throw UsageError("option 'storage': unknown value '" + storage + "'");
 }
 
-vk::Defines storage_defines(const PrecomputeSettings& s, bool native_r11g11b10) {
+vk::Defines storage_defines(const PrecomputeSettings& s, const IblResources& r) {
     vk::Defines d = glsl_defines({{"storage", s.storage}, {"mip_mapping", s.mip_mapping}, {"env_layout", s.env_layout}});
-    if (s.storage == "rgbm8" || s.storage == "astc_ldr_rgbm") d["RGBM_RANGE"] = std::to_string(s.rgbm_range);
-    if (s.storage == "r11g11b10" && native_r11g11b10) d["STORAGE_NATIVE_R11G11B10"] = "1";
+    if (is_rgbm(s.storage)) d["RGBM_RANGE"] = std::to_string(r.rgbm_range);
+    if (s.storage == "r11g11b10" && r.native_r11g11b10) d["STORAGE_NATIVE_R11G11B10"] = "1";
     return d;
 }
 
@@ -210,8 +240,13 @@ void record_prefilter(const Recording& rec, const vk::ComputePipeline& p, const 
     vk::Context& ctx = rec.ctx;
     for (uint32_t m = 0; m < mips; ++m) {
         if (m == 0) { // warm-up: a mip-0 copy of one workgroup, overwritten below
-            PrefilterPush pw{
-                0, s.cube_size, s.cube_size, s.prefilter_samples, float(r.full_mips), float(mips - 1), float(r.full_mips - 1)};
+            PrefilterPush pw{0,
+                             s.cube_size,
+                             s.cube_size,
+                             s.prefilter_samples,
+                             float(cubemap_max_mip(s.cube_size)),
+                             float(mips - 1),
+                             float(r.full_mips - 1)};
             p.warm_up(rec.cmd,
                       {vk::Binding::sampled_image(0, r.source_cube.sampled_view, ctx.linear_sampler()),
                        vk::Binding::storage_image(1, r.prefiltered.storage_views[0])},
@@ -220,7 +255,8 @@ void record_prefilter(const Recording& rec, const vk::ComputePipeline& p, const 
         }
         // dst_size: the cube's face size, or a 2D layout level's width (its height follows).
         const uint32_t w = std::max(1u, extent.width >> m), h = std::max(1u, extent.height >> m);
-        PrefilterPush pp{m, w, s.cube_size, s.prefilter_samples, float(r.full_mips), float(mips - 1), float(r.full_mips - 1)};
+        PrefilterPush pp{
+            m, w, s.cube_size, s.prefilter_samples, float(cubemap_max_mip(s.cube_size)), float(mips - 1), float(r.full_mips - 1)};
         p.dispatch(rec.cmd,
                    {vk::Binding::sampled_image(0, r.source_cube.sampled_view, ctx.linear_sampler()),
                     vk::Binding::storage_image(1, r.prefiltered.storage_views[m])},
@@ -277,20 +313,19 @@ IblResources run_precompute(GpuSession& gpu, const Environment& env, const Preco
     if (s.cube_size < 8 || s.cube_size > 2048 || (s.cube_size & (s.cube_size - 1)))
         throw UsageError("option 'cube_size': " + std::to_string(s.cube_size) + " must be a power of two in 8..2048");
     IblResources r;
-    r.full_mips = uint32_t(std::log2(double(s.cube_size))) + 1;
-    const uint32_t mips = std::min(s.mips, r.full_mips);
-    if (mips < 1) throw UsageError("option 'mips' must be at least 1");
+    r.full_mips = cubemap_max_mip(s.cube_size) + 1;
     const EnvLayout layout = env_layout_from_option(s.env_layout);
+    // The chain reaches r = 1 whatever the base size, or the configuration is refused (issue 27).
+    check_layout_settings(s, layout, s.mips);
+    const uint32_t mips = s.prefiltered ? chain_levels(s.mip_mapping, layout, s.cube_size, s.mips) : 1;
+    r.levels = mips;
     const LayoutExtent extent = layout_extent(layout, s.cube_size);
-    check_layout_settings(s, layout, mips);
 
     const EquirectUpload equirect = stage_equirect(ctx, env.equirect);
     allocate_outputs(ctx, s, layout, extent, mips, r);
 
     const auto& p_e2c = gpu.pipeline("equirect_to_cube.comp", {}, {kSampled, kStorageImage}, sizeof(EquirectToCubePush));
     const auto& p_down = gpu.pipeline("downsample_cube.comp", {}, {kStorageImage, kStorageImage}, sizeof(DownsamplePush));
-    const auto& p_pre = gpu.pipeline("prefilter_ggx.comp", storage_defines(s, r.native_r11g11b10), {kSampled, kStorageImage},
-                                     sizeof(PrefilterPush));
     const auto& p_sh = gpu.pipeline("sh9_project.comp", {}, {kStorageImage, kStorageBuffer}, sizeof(Sh9Push));
 
     vk::GpuTimer timer(ctx, 8);
@@ -300,6 +335,13 @@ IblResources run_precompute(GpuSession& gpu, const Environment& env, const Preco
         record_upload(rec, equirect);
         record_equirect_to_cube(rec, p_e2c, equirect.image);
         record_downsample(rec, p_down);
+    });
+    // RGBM's range comes from the source cube, so the chain is encoded in a second submission.
+    if (s.prefiltered && is_rgbm(s.storage)) fit_rgbm_range(ctx, r.source_cube, s.rgbm_range, r);
+    const auto& p_pre =
+        gpu.pipeline("prefilter_ggx.comp", storage_defines(s, r), {kSampled, kStorageImage}, sizeof(PrefilterPush));
+    ctx.submit([&](VkCommandBuffer cmd) {
+        const Recording rec{gpu, ctx, cmd, timer, s, r};
         if (s.prefiltered) record_prefilter(rec, p_pre, extent, mips);
         record_sh9(rec, p_sh);
         if (s.lut) record_dfg_lut(rec);
@@ -308,7 +350,7 @@ IblResources run_precompute(GpuSession& gpu, const Environment& env, const Preco
     });
     for (auto& [name, ms] : timer.results()) timings.push_back({name, ms, true, true});
     // ASTC is encoded on the host, so its round trip follows the GPU passes.
-    if (s.prefiltered && is_astc(s.storage)) r.prefiltered = astc_round_trip(ctx, r.prefiltered, s, timings);
+    if (s.prefiltered && is_astc(s.storage)) r.prefiltered = astc_round_trip(ctx, r.prefiltered, s, r.rgbm_range, timings);
     return r;
 }
 

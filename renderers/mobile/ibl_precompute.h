@@ -12,16 +12,16 @@
 namespace iblcheck {
 
 struct PrecomputeSettings {
-    uint32_t cube_size = 128; // base size of the cubes (64–512)
-    uint32_t mips = 7;        // levels of the prefiltered chain (the first seed's 7)
-    uint32_t prefilter_samples = 64;
-    std::string mip_mapping = "ue4"; // ue4 | filament | origin
-    std::string storage = "rgba16f"; // rgba16f | rgba32f | rgbm8 | r11g11b10 | astc_hdr | astc_ldr_rgbm
-    std::string astc_block = "4x4";  // storage=astc_*: 4x4 | 6x6
-    float rgbm_range = 6.0f;
-    std::string env_layout = "cube"; // cube | octahedral | equirect (env_layout.h)
-    bool prefiltered = true;         // build the GGX chain (the sampled method does not need it)
-    bool lut = false;                // env_brdf=lut
+    uint32_t cube_size = 128;         // base size of the cubes (64–512)
+    uint32_t mips = 0;                // levels of the prefiltered chain; 0: the full chain (mip_chain.h: chain_levels)
+    uint32_t prefilter_samples = 256; // the prefilter's noise: < 1 % of the error against the truth (issue 27)
+    std::string mip_mapping = "ue4";  // ue4 | filament | origin
+    std::string storage = "rgba16f";  // rgba16f | rgba32f | rgbm8 | r11g11b10 | astc_hdr | astc_ldr_rgbm
+    std::string astc_block = "4x4";   // storage=astc_*: 4x4 | 6x6
+    float rgbm_range = 0.0f;          // storage=rgbm8|astc_ldr_rgbm: 0 = the source's peak (option rgbm_range=peak)
+    std::string env_layout = "cube";  // cube | octahedral | equirect (env_layout.h)
+    bool prefiltered = true;          // build the GGX chain (the sampled method does not need it)
+    bool lut = false;                 // env_brdf=lut
     uint32_t lut_size = 64;
     uint32_t lut_samples = 512;
     bool irradiance_cube = false; // diffuse=irradiance_cube
@@ -35,13 +35,18 @@ struct IblResources {
     vk::Buffer sh;          // 10 × vec4: SH9 of E/π, then the mean radiance
     vk::Image lut;          // rg16f (1×1 placeholder when unused)
     vk::Image irradiance;   // rgba32f cube (1×1 placeholder when unused)
-    uint32_t full_mips = 0; // log2(cube_size) + 1
+    uint32_t full_mips = 0; // log2(cube_size) + 1: the source pyramid's levels
+    uint32_t levels = 0;    // the prefiltered chain's levels (mip_chain.h: chain_levels)
     bool native_r11g11b10 = false;
     // The prefiltered chain as a device would store it: texels (borders of 2D layouts included)
     // and bytes in the storage format (ASTC: its blocks; r11g11b10: 4 bytes a texel even where
     // lavapipe holds it in RGBA16F).
     uint64_t texel_count = 0;
     uint64_t texture_bytes = 0;
+    // RGBM storage: the range the chain was encoded with, and the share of the base level's
+    // radiant energy above it (what the clamp to the range loses in the sharpest level).
+    float rgbm_range = 0;
+    double rgbm_clipped_energy = 0;
 };
 
 // Bytes of one w×h level of `layers` layers in the storage format.
@@ -60,7 +65,7 @@ std::shared_ptr<IblResources> precompute_cached(GpuSession& gpu, const Environme
 
 // The defines of the passes that read or write the prefiltered chain: the option table's for
 // storage, mip_mapping and env_layout (storage.glsl, mip_mapping.glsl, env_layout.glsl), plus the
-// RGBM range and whether R11G11B10 is stored natively.
-vk::Defines storage_defines(const PrecomputeSettings& s, bool native_r11g11b10);
+// RGBM range the chain was encoded with (r.rgbm_range) and whether R11G11B10 is stored natively.
+vk::Defines storage_defines(const PrecomputeSettings& s, const IblResources& r);
 
 } // namespace iblcheck

@@ -7,6 +7,7 @@
 #include "gpu_scene.h"
 #include "harness/common/errors.h"
 #include "ibl_precompute.h"
+#include "mip_chain.h"
 #include "renderers/mobile/descriptor_types.h"
 #include "renderers/option_table.h"
 #include "renderers/scenes/scene.h"
@@ -29,14 +30,19 @@ MobileOptions read_mobile_options(const OptionMap& o) {
     MobileOptions m;
     PrecomputeSettings& ps = m.ps;
     ps.cube_size = uint32_t(o.get_int("cube_size", 128));
-    ps.mips = uint32_t(o.get_int("mips", 7));
-    ps.prefilter_samples = uint32_t(o.get_int("prefilter_samples", 64));
+    ps.mips = o.has("mips") ? uint32_t(std::max(0, o.get_int("mips", 0))) : 0; // 0: the full chain
+    if (o.has("mips") && ps.mips < 1) throw UsageError("option 'mips' must be at least 1 (leave it out for the full chain)");
+    ps.prefilter_samples = uint32_t(o.get_int("prefilter_samples", 256));
     m.variant = shader_selections(o, "mobile");
     ps.mip_mapping = m.variant.at("mip_mapping");
     ps.storage = m.variant.at("storage");
     ps.astc_block = option_choice(o, "astc_block");
     ps.env_layout = m.variant.at("env_layout");
-    ps.rgbm_range = float(o.get_double("rgbm_range", 6.0));
+    // rgbm_range: "peak" (default: the source's peak, ibl_precompute.cpp) or a fixed range.
+    if (o.get_string("rgbm_range", "peak") != "peak") {
+        ps.rgbm_range = float(o.get_double("rgbm_range", 0.0));
+        if (!(ps.rgbm_range > 0)) throw UsageError("option 'rgbm_range' must be 'peak' or a number > 0");
+    }
     ps.lut = m.variant.at("env_brdf") == "lut";
     ps.lut_size = uint32_t(o.get_int("lut_size", 64));
     ps.irradiance_cube = m.variant.at("diffuse") == "irradiance_cube";
@@ -57,7 +63,7 @@ std::optional<vk::Fp16Path> fp16_path_of(GpuSession& gpu, const MobileOptions& m
 // The shading pass's defines: the storage's, the other selections', and per-sphere AO where the
 // scene has it (scene.glsl).
 vk::Defines shading_defines(const MobileOptions& m, const IblResources& ibl, const Scene& scene) {
-    vk::Defines defs = storage_defines(m.ps, ibl.native_r11g11b10);
+    vk::Defines defs = storage_defines(m.ps, ibl);
     defs.merge(glsl_defines(m.variant)); // keeps storage_defines' entries; adds the other selections
     if (scene_uses_ao(scene)) defs["MATERIAL_AO"] = "1";
     return defs;
@@ -70,8 +76,8 @@ ShadePush shade_push(const OptionMap& o, int width, int height, const Precompute
     ShadePush pc{uint32_t(width),
                  uint32_t(height),
                  uint32_t(ssaa_of(o)),
-                 float(ibl.full_mips),
-                 float(std::min(ps.mips, ibl.full_mips) - 1),
+                 float(cubemap_max_mip(ps.cube_size)),
+                 float(ibl.levels - 1),
                  float(o.get_double("mix_begin_roughness", 0.1)),
                  float(o.get_double("mix_end_roughness", 0.3)),
                  float(o.get_double("mix_largest_weight", 10000.0)),
@@ -147,8 +153,12 @@ nlohmann::json mobile_provenance(const MobileOptions& m, const IblResources& ibl
             {"cost", cost_provenance(instructions, texture_fetches_per_pixel)},
             {"precompute_cached", cached},
             {"cube_size", ps.cube_size},
-            {"mips", std::min(ps.mips, ibl.full_mips)},
+            {"mips", ibl.levels},
             {"storage_native", ps.storage != "r11g11b10" || ibl.native_r11g11b10},
+            {"rgbm", ibl.rgbm_range > 0 ? nlohmann::json{{"range", ibl.rgbm_range},
+                                                         {"range_from", ps.rgbm_range > 0 ? "option" : "peak"},
+                                                         {"clipped_energy", ibl.rgbm_clipped_energy}}
+                                        : nlohmann::json()},
             {"texture", {{"layout", ps.env_layout}, {"texels", ibl.texel_count}, {"bytes", ibl.texture_bytes}}},
             {"shader_variant", glsl_selection_names(m.variant)}};
 }

@@ -11,7 +11,7 @@ namespace iblcheck {
 struct ShadePush {
     uint32_t width, height; // compute: the image; fragment: the framebuffer (image × ssaa)
     uint32_t ssaa;
-    float full_mips, max_lod, mix_begin, mix_end, mix_largest, indirect, aa_variance, aa_threshold, rot;
+    float cubemap_max_mip, max_lod, mix_begin, mix_end, mix_largest, indirect, aa_variance, aa_threshold, rot;
 };
 static_assert(sizeof(ShadePush) == 48, "split_sum.glsl's Push block is 48 bytes");
 
@@ -38,7 +38,7 @@ static_assert(sizeof(DownsamplePush) == 4, "downsample_cube.comp's Push block is
 // prefilter_ggx.comp's Push.
 struct PrefilterPush {
     uint32_t mip, dst_size, source_size, sample_count; // dst_size: cube face size, or a 2D level's width
-    float full_mips, max_lod, source_max_lod;
+    float cubemap_max_mip, max_lod, source_max_lod;    // cubemap_max_mip: log2(cube_size), mip_mapping.glsl
 };
 static_assert(sizeof(PrefilterPush) == 28, "prefilter_ggx.comp's Push block is 28 bytes");
 

@@ -7,6 +7,7 @@
 #include "renderers/mobile/ibl_precompute.h"
 #include "renderers/mobile/push_constants.h"
 #include "renderers/mobile/shading_cost.h"
+#include "renderers/option_table.h"
 
 namespace iblcheck {
 
@@ -29,7 +30,8 @@ RenderResult render_sampled(GpuSession& gpu, const Environment& env, const TestS
     const std::vector<VkDescriptorType> types = {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
                                                  VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
                                                  VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
-    const auto& shade = gpu.pipeline("shade_sampled.comp", {}, types, sizeof(SampledPush));
+    const vk::Defines defines = glsl_defines(shader_selections(o, "sampled")); // mip_clamp
+    const auto& shade = gpu.pipeline("shade_sampled.comp", defines, types, sizeof(SampledPush));
     vk::Context& ctx = gpu.ctx();
     vk::Buffer scene_buf = upload_scene(ctx, scene);
     vk::Buffer out = ctx.create_buffer(VkDeviceSize(width) * height * 16);
@@ -56,7 +58,7 @@ RenderResult render_sampled(GpuSession& gpu, const Environment& env, const TestS
     double coverage = read_back_image(out, width, height, result.image, "shade_sampled.comp");
     result.texture_fetches_per_pixel = coverage * pc.ssaa * pc.ssaa * samples;
     auto instructions =
-        shading_instructions_per_pixel(gpu, {"shade_sampled.comp", {}, types, {}, b, 5, &pc, sizeof pc, width, height}, out);
+        shading_instructions_per_pixel(gpu, {"shade_sampled.comp", defines, types, {}, b, 5, &pc, sizeof pc, width, height}, out);
     result.shader_instructions_per_pixel = instructions.value_or(0);
     result.provenance = {{"method", "sampled"}, {"precompute_cached", cached},
                          {"samples", samples},  {"cube_size", ps.cube_size},

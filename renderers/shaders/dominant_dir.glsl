@@ -4,16 +4,24 @@
 #ifndef IBLCHECK_DOMINANT_DIR_GLSL
 #define IBLCHECK_DOMINANT_DIR_GLSL
 #include "precision.glsl"
-#ifndef DOMINANT_DIR
-#error "DOMINANT_DIR is set from the option table (renderers/option_table.cpp)"
+#if !defined(DOMINANT_DIR) || !defined(LAGARDE_ROUGHNESS)
+#error "DOMINANT_DIR and LAGARDE_ROUGHNESS are set from the option table (renderers/option_table.cpp)"
 #endif
 
 hvec3 specular_dominant_dir(hvec3 n, hvec3 r, hfloat roughness) {
 #if DOMINANT_DIR == DOMINANT_DIR_LAGARDE
     // Lagarde & de Rousiers 2014, "Moving Frostbite to PBR", listing 22 (first seed): not
-    // normalised, as the lookup is in a cubemap.
-    hfloat smoothness = clamp(hfloat(1.0) - roughness, hfloat(0.0), hfloat(1.0));
-    hfloat lerp_factor = smoothness * (sqrt(smoothness) + roughness);
+    // normalised, as the lookup is in a cubemap. Its `roughness` is α = r²: the notes' listings keep
+    // `linearRoughness` for the perceptual r, and evaluateIBLSpecular (listing 24) passes
+    // `roughness`, not `linearRoughness`, to getSpecularDominantDir (Blender's EEVEE passes
+    // roughnessSquared too). Some ports pass the perceptual r: option lagarde_roughness=perceptual.
+#if LAGARDE_ROUGHNESS == LAGARDE_ROUGHNESS_ALPHA
+    hfloat a = roughness * roughness;
+#elif LAGARDE_ROUGHNESS == LAGARDE_ROUGHNESS_PERCEPTUAL
+    hfloat a = roughness;
+#endif
+    hfloat smoothness = clamp(hfloat(1.0) - a, hfloat(0.0), hfloat(1.0));
+    hfloat lerp_factor = smoothness * (sqrt(smoothness) + a);
     return mix(n, r, lerp_factor);
 #elif DOMINANT_DIR == DOMINANT_DIR_FILAMENT
     // Filament (Filament.md, "Specular dominant direction"): mix(r, n, α²) with α = roughness².

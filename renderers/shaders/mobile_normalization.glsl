@@ -5,7 +5,7 @@
 //   scale        = lerp(1, MixingWeight, MixingAlpha)
 // average_brightness is the rgb mean (not luminance: UE4's choice, see the seed) of the 1×1 mip,
 // i.e. the mean radiance of the environment. indirect_irradiance is what a lightmap or the
-// indirect-lighting cache would give: by default the rgb mean of the SH9 diffuse lighting E(n)/π,
+// indirect-lighting cache would give: by default UE4's Luminance() of the SH9 diffuse lighting E(n)/π,
 // or a constant (option indirect_irradiance). Material AO (option ao) multiplies it (seed 001: so
 // an AO map darkens a metal's reflections once the normalisation mixes in).
 //

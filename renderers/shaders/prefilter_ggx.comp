@@ -4,7 +4,10 @@
 // each sample reads the source pyramid at the lod whose texel solid angle matches the sample's,
 //   lod = 0.5·log2(Ωs / Ωp) + 1,  Ωs = 1 / (N · pdf),  Ωp = 4π / (6 · base²),  pdf = D(h) / 4 at n = v.
 // Hammersley points are rotated per texel (random_rotation), which trades banding for noise.
-// Mip 0 is an exact copy of the source (a mirror); mip m ≥ 1 uses roughness lod_to_roughness(m).
+// Every level m holds roughness lod_to_roughness(m), the curve the lookup inverts (mip_mapping.glsl),
+// mip 0 included: a level is a copy of the source (a mirror) only where the curve assigns it
+// r < 0.01, UE4's threshold (ReflectionEnvironmentShaders.usf FilterPS). So UE4's curve, which gives
+// a 128² chain's mip 0 r ≈ 0.056, gets a filtered mip 0, and filament/origin (r = 0 there) a mirror.
 // The destination is a cube level or, for a 2D env_layout, one level of the octahedral or lat-long
 // map with its border (env_layout.glsl): a border texel is computed as the inner texel it copies
 // (same direction, same random rotation), so it holds exactly that texel's value.
@@ -14,6 +17,9 @@
 #include "mip_mapping.glsl"
 #include "storage.glsl"
 
+// Below this roughness a level is a copy of the source level of its own size (UE4 FilterPS: 0.01).
+const float MIRROR_ROUGHNESS = 0.01;
+
 layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;
 layout(binding = 0) uniform samplerCube source;   // rgba32f, box-filtered pyramid
 layout(binding = 1, STORAGE_FORMAT) uniform writeonly ENV_IMAGE dst;
@@ -22,7 +28,7 @@ layout(push_constant) uniform Push {
     uint dst_size;        // cube: face size; 2D layout: level width
     uint source_size;
     uint sample_count;
-    float full_mips;
+    float cubemap_max_mip;     // log2(base size): UE4's CubemapMaxMip (mip_mapping.glsl)
     float max_lod;
     float source_max_lod;
 } pc;
@@ -41,10 +47,10 @@ void main() {
     uvec3 seed_texel = uvec3(source_texel, 0u);
 #endif
     vec3 result;
-    if (pc.mip == 0u) {
-        result = textureLod(source, n, 0.0).rgb;
+    float r = lod_to_roughness(float(pc.mip), pc.cubemap_max_mip, pc.max_lod);
+    if (r < MIRROR_ROUGHNESS) {
+        result = textureLod(source, n, float(pc.mip)).rgb;
     } else {
-        float r = lod_to_roughness(float(pc.mip), pc.full_mips, pc.max_lod);
         float alpha = max(r * r, 1e-4);
         float omega_p = 4.0 * PI / (6.0 * float(pc.source_size * pc.source_size));
         vec2 rot = random_rotation(uvec3(seed_texel.xy, seed_texel.z + 6u * pc.mip));

@@ -30,7 +30,7 @@ layout(push_constant) uniform Push {
     uint width;                   // the frame's size in pixels (fragment: the framebuffer's)
     uint height;
     uint ssaa;                    // compute: n x n rays per pixel; fragment: unused (the host supersamples)
-    float full_mips;
+    float cubemap_max_mip;     // log2(base size): UE4's CubemapMaxMip (mip_mapping.glsl)
     float max_lod;
     float mix_begin_roughness;
     float mix_end_roughness;
@@ -40,6 +40,9 @@ layout(push_constant) uniform Push {
     float specular_aa_threshold;  // κ clamp
     float env_rotation_deg;       // unused here (baked into the cube); kept for layout parity
 } pc;
+
+// UE4's Luminance() (Common.ush): dot(c, (0.3, 0.59, 0.11)).
+const hvec3 UE4_LUMINANCE = hvec3(0.3, 0.59, 0.11);
 
 vec3 diffuse_radiance(vec3 n) {
 #if DIFFUSE == DIFFUSE_IRRADIANCE_CUBE
@@ -67,7 +70,7 @@ vec3 shade_surface(SphereGpu s, vec3 n, vec3 v, float roughness) {
     hfloat n_dot_v = max(dot(hn, hv), hfloat(1e-4));
     hvec3 refl = hfloat(2.0) * dot(hn, hv) * hn - hv;
     vec3 dir = vec3(specular_dominant_dir(hn, refl, hr));
-    float lod = roughness_to_lod(roughness, pc.full_mips, pc.max_lod);
+    float lod = roughness_to_lod(roughness, pc.cubemap_max_mip, pc.max_lod);
     hvec3 spec_light = hvec3(decode_storage(SAMPLE_ENV(prefiltered, dir, lod)));
 
 #if ENV_BRDF == ENV_BRDF_LUT
@@ -78,15 +81,19 @@ vec3 shade_surface(SphereGpu s, vec3 n, vec3 v, float roughness) {
     hvec3 f0 = mix(hvec3(0.04), hvec3(base), hfloat(metallic));
     hvec3 specular = spec_light * (f0 * ab.x + ab.y);
 
+    // UE4 (BasePassPixelShader.usf, GetPrecomputedIndirectLightingAndSkyLight): IndirectIrradiance =
+    // Luminance(DiffuseLighting), its Luminance's weights; the rgb mean is for the capture's average
+    // brightness only (below).
     hfloat indirect = pc.indirect_irradiance >= 0.0 ? hfloat(pc.indirect_irradiance)
-                                                    : dot(hvec3(diffuse_light), hvec3(1.0 / 3.0));
+                                                    : dot(hvec3(diffuse_light), UE4_LUMINANCE);
 #ifdef MATERIAL_AO
     if (pc.indirect_irradiance >= 0.0) indirect *= hfloat(s.ao_pad.x);  // from SH9 it has the AO already
 #endif
 #if NORMALIZATION == NORMALIZATION_DIRECTIONAL
-    // The chain's own brightness at n, from its r = 1 level: E(n)/π (mobile_normalization.glsl).
-    hfloat average_brightness = dot(hvec3(decode_storage(SAMPLE_ENV(prefiltered, n, roughness_to_lod(1.0, pc.full_mips, pc.max_lod)))),
-                                    hvec3(1.0 / 3.0));
+    // The chain's own brightness at n, from its r = 1 level: E(n)/π (mobile_normalization.glsl), in
+    // the same Luminance() as indirect_irradiance, so that the ratio is 1 where the two agree.
+    hfloat average_brightness = dot(hvec3(decode_storage(SAMPLE_ENV(prefiltered, n, roughness_to_lod(1.0, pc.cubemap_max_mip, pc.max_lod)))),
+                                    UE4_LUMINANCE);
 #else
     hfloat average_brightness = dot(hvec3(sh.coeffs[9].rgb), hvec3(1.0 / 3.0));
 #endif
