@@ -14,8 +14,8 @@
 
 #include "golden_store.h"
 #include "harness/common/errors.h"
-#include "harness/common/shell_quote.h"
 #include "harness/common/input_file.h"
+#include "harness/common/shell_quote.h"
 #include "image_compare.h"
 #include "metrics/image_io.h"
 #include "provenance.h"

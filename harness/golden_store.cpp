@@ -10,8 +10,8 @@
 #include <unistd.h>
 
 #include "harness/common/errors.h"
-#include "metrics/image_formats.h"
 #include "harness/common/input_file.h"
+#include "metrics/image_formats.h"
 #include "metrics/image_io.h"
 
 namespace fs = std::filesystem;

@@ -13,8 +13,8 @@
 #include <nlohmann/json.hpp>
 
 #include "harness/common/errors.h"
-#include "harness/common/output_files.h"
 #include "harness/common/input_file.h"
+#include "harness/common/output_files.h"
 #include "metrics/flip.h"
 #include "metrics/flip_json.h"
 #include "metrics/image_io.h"

@@ -17,9 +17,9 @@
 
 #include "commands.h"
 #include "harness/common/errors.h"
+#include "harness/common/input_file.h"
 #include "harness/common/output_files.h"
 #include "harness/common/shell_quote.h"
-#include "harness/common/input_file.h"
 #include "harness/golden_store.h"
 #include "renderers/reference/monte_carlo_golden.h"
 #include "renderers/reference/truth_golden.h"
