@@ -193,6 +193,7 @@ json run_test(const TestCase& tc, Worker& w, const GoldenStore& store, const std
         record_render(t.r, rr);
         repeat_timings(t.r, tc, w, timing_repeats);
         if (NonFinite nf = find_non_finite(rr.image); nf.count) throw NonFiniteRender("render: " + nf.describe());
+        if (!rr.non_finite_coverage.empty()) throw NonFiniteRender(rr.non_finite_coverage);
         if (t.art) record_images(t, rr);
         const BaselineOutcome base = tc.baseline ? check_baselines(t, rr) : BaselineOutcome{};
         const cv::Mat reference = tc.reference ? check_reference(t, rr, base) : cv::Mat();

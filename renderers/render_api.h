@@ -51,6 +51,11 @@ struct RenderResult {
     uint64_t texel_count = 0;
     uint64_t texture_bytes = 0;
     SphereCoverage coverage; // filled by Renderer::render() for every method
+    // "<shader>: alpha (coverage) channel: N non-finite value(s) (NaN/Inf), first at x=X, y=Y" when
+    // the shading pass wrote NaN/Inf coverage (empty otherwise): the shader's fault, a regression.
+    // It is reported, not thrown, so the image is still kept for inspection (render --out, run's
+    // full-precision render of a failure) before the verdict, as for NaN/Inf pixels.
+    std::string non_finite_coverage;
 };
 
 } // namespace iblcheck

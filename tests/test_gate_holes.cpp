@@ -19,6 +19,7 @@
 #include "harness/golden_store.h"
 #include "harness/runner.h"
 #include "metrics/image_io.h"
+#include "tests/furnace_store.h"
 #include "tests/test_support.h"
 
 namespace fs = std::filesystem;
@@ -38,24 +39,11 @@ const char* kMiniSuite = R"({
                "reference_band": {"flip.mean": {"below": 0.2, "above": 0.1, "abs": 0.0}}},
   "tests": [{"scene": "furnace", "method": "mobile"}]
 })";
-const std::string kMiniTest = "mobile.furnace.constant:1.default";
+const std::string& kMiniTest = kFurnaceTest;
 
 // A private golden folder with the furnace reference and freshly blessed mini baselines.
-struct MiniStore {
-    fs::path dir, suite, goldens;
-    explicit MiniStore(const std::string& name) : dir(temp_dir(name)), suite(dir / "mini.json"), goldens(dir / "goldens") {
-        std::ofstream(suite) << kMiniSuite;
-        fs::create_directories(goldens / "reference");
-        for (const char* ext : {".exr", ".json"})
-            fs::copy(fs::path(IBLCHECK_SOURCE_DIR) / (std::string("goldens/reference/furnace__constant-1") + ext),
-                     goldens / "reference");
-        BlessOptions b;
-        b.suite = suite.string();
-        b.goldens = goldens;
-        EXPECT_EQ(bless(b), kExitPass);
-    }
-    ~MiniStore() { fs::remove_all(dir); }
-    fs::path baseline() const { return GoldenStore(goldens).baseline_path(kMiniTest); }
+struct MiniStore : FurnaceStore {
+    explicit MiniStore(const std::string& name) : FurnaceStore(name, kMiniSuite) { EXPECT_EQ(bless_all(), kExitPass); }
     RunSummary run(const fs::path& out = {}) const {
         RunOptions o;
         o.suite = suite.string();

@@ -368,15 +368,17 @@ TEST(Cli, BadInputExitsTwo) {
 }
 
 TEST(Cli, RenderReportsTheEnvironmentTexture) {
-    // The prefiltered chain's texels and bytes (7 levels of a 128 cube; ASTC 4x4: 16 bytes a block).
+    // The prefiltered chain's texels and bytes: the full chain of a 128 cube, 128² down to 1²
+    // (8 levels: the chain reaches r = 1, issue 27; ASTC 4x4: 16 bytes a block, one block each for
+    // the 4², 2² and 1² levels).
     std::string out;
     ASSERT_EQ(
         run_command(iblcheck_bin() + " render --scene sphere --env constant:1 --set storage=astc_hdr --json - 2>/dev/null", out),
         0)
         << out;
     auto j = nlohmann::json::parse(out.substr(out.find('{')));
-    EXPECT_EQ(j["texture_bytes"].get<uint64_t>(), 6u * 16 * (1024 + 256 + 64 + 16 + 4 + 1 + 1));
-    EXPECT_EQ(j["texel_count"].get<uint64_t>(), 6u * 21844);
+    EXPECT_EQ(j["texture_bytes"].get<uint64_t>(), 6u * 16 * (1024 + 256 + 64 + 16 + 4 + 1 + 1 + 1));
+    EXPECT_EQ(j["texel_count"].get<uint64_t>(), 6u * (16384 + 4096 + 1024 + 256 + 64 + 16 + 4 + 1));
     bool encoded = false;
     for (auto& t : j["timings"]) encoded |= t["pass"] == "astc_encode" && t["precompute"] == true;
     EXPECT_TRUE(encoded) << out;

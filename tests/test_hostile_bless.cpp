@@ -16,6 +16,7 @@
 #include "harness/golden_store.h"
 #include "harness/suite.h"
 #include "reports/verdict_text.h"
+#include "tests/furnace_store.h"
 #include "tests/test_support.h"
 
 namespace fs = std::filesystem;
@@ -27,29 +28,15 @@ namespace {
 
 std::string bin(const std::string& name) { return std::string(IBLCHECK_BINARY_DIR) + "/" + name; }
 
-const std::string kMiniTest = "mobile.furnace.constant:1.default";
+const std::string& kMiniTest = kFurnaceTest;
 
-// A suite of one furnace test and a private golden folder holding the furnace's truth.
-struct Store {
-    fs::path dir, suite, goldens;
-    explicit Store(const std::string& name) : dir(temp_dir(name)), suite(dir / "mini.json"), goldens(dir / "goldens") {
-        write_file(suite, R"({"suite": "mini", "defaults": {"env": "constant:1",
+// A suite of one furnace test (not blessed yet) and a private golden folder holding its truth.
+struct Store : FurnaceStore {
+    explicit Store(const std::string& name)
+        : FurnaceStore(name, R"({"suite": "mini", "defaults": {"env": "constant:1",
                     "baseline_tolerances": {"flip.mean": {"max": 0.001}}},
-                    "tests": [{"scene": "furnace", "method": "mobile"}]})");
-        fs::create_directories(goldens / "reference");
-        for (const char* ext : {".exr", ".json"})
-            fs::copy(fs::path(IBLCHECK_SOURCE_DIR) / (std::string("goldens/reference/furnace__constant-1") + ext),
-                     goldens / "reference");
-    }
-    ~Store() { fs::remove_all(dir); }
-    BlessOptions options() const {
-        BlessOptions b;
-        b.suite = suite.string();
-        b.goldens = goldens;
-        return b;
-    }
-    fs::path baseline() const { return GoldenStore(goldens).baseline_path(kMiniTest); }
-    fs::path sidecar() const { return fs::path(baseline()).replace_extension(".json"); }
+                    "tests": [{"scene": "furnace", "method": "mobile"}]})") {}
+    BlessOptions options() const { return bless_options(); }
 };
 
 std::vector<std::string> names(const Suite& s) {
@@ -64,8 +51,9 @@ TEST(HostileBless, SizeIsInTheTestNameSoASmallerRenderNeverSharesCisGolden) {
     // A suite with "size": "1x1" named its test mobile.sphere.studio.default, like ci's, and bless
     // overwrote ci's golden with a 1x1 image.
     fs::path dir = temp_dir("size_name");
-    write_file(dir / "tiny.json", R"({"suite": "tiny", "tests": [{"scene": "sphere", "method": "mobile", "size": "1x1"},
-        {"scene": "sphere", "method": "mobile", "size": "64x32", "variants": [{"shading": "fragment"}]}]})");
+    write_file(dir / "tiny.json",
+               R"({"suite": "tiny", "tests": [{"scene": "sphere", "method": "mobile", "size": "1x1", "measure_only": true},
+        {"scene": "sphere", "method": "mobile", "size": "64x32", "variants": [{"shading": "fragment"}], "measure_only": true}]})");
     EXPECT_EQ(names(load_suite((dir / "tiny.json").string())),
               (std::vector<std::string>{"mobile.sphere.studio.size=1x1", "mobile.sphere.studio.shading=fragment,size=64x32"}));
     // The suites without a size keep their names, and so their goldens.
@@ -177,7 +165,9 @@ TEST(HostileBless, PrintedCommandsAreShellQuotedAndSelectTheirTestOnly) {
     fs::copy(fs::path(IBLCHECK_SOURCE_DIR) / "goldens/reference/furnace__constant-1.exr", env);
     write_file(
         dir / "s.json",
-        json{{"suite", "s"}, {"tests", {{{"scene", "sphere"}, {"method", "mobile"}, {"env", {env.string(), "studio"}}}}}}.dump());
+        json{{"suite", "s"},
+             {"tests", {{{"scene", "sphere"}, {"method", "mobile"}, {"env", {env.string(), "studio"}}, {"measure_only", true}}}}}
+            .dump());
     const Suite suite = load_suite((dir / "s.json").string());
     const TestCase& tc = suite.tests[0];
     const std::string cmd = bless_command(tc);

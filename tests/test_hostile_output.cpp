@@ -15,6 +15,7 @@
 #include "harness/suite.h"
 #include "harness/test_run.h"
 #include "reports/report_writer.h"
+#include "tests/furnace_store.h"
 #include "tests/test_support.h"
 
 namespace fs = std::filesystem;
@@ -27,22 +28,13 @@ namespace {
 std::string bin(const std::string& name) { return std::string(IBLCHECK_BINARY_DIR) + "/" + name; }
 
 // A blessed one-test suite (the furnace) in a private folder, run through the CLI.
-struct Mini {
-    fs::path dir, suite, goldens;
-    explicit Mini(const std::string& name) : dir(temp_dir(name)), suite(dir / "mini.json"), goldens(dir / "goldens") {
-        write_file(suite, R"({"suite": "mini", "defaults": {"env": "constant:1",
+struct Mini : FurnaceStore {
+    explicit Mini(const std::string& name)
+        : FurnaceStore(name, R"({"suite": "mini", "defaults": {"env": "constant:1",
                     "baseline_tolerances": {"flip.mean": {"max": 0.001}}},
-                    "tests": [{"scene": "furnace", "method": "mobile"}]})");
-        fs::create_directories(goldens / "reference");
-        for (const char* ext : {".exr", ".json"})
-            fs::copy(fs::path(IBLCHECK_SOURCE_DIR) / (std::string("goldens/reference/furnace__constant-1") + ext),
-                     goldens / "reference");
-        BlessOptions b;
-        b.suite = suite.string();
-        b.goldens = goldens;
-        EXPECT_EQ(bless(b), kExitPass);
+                    "tests": [{"scene": "furnace", "method": "mobile"}]})") {
+        EXPECT_EQ(bless_all(), kExitPass);
     }
-    ~Mini() { fs::remove_all(dir); }
     int run(const std::string& args, std::string& out) const {
         return run_command(bin("iblcheck") + " run -q --suite " + suite.string() + " --goldens " + goldens.string() + " " + args,
                            out);

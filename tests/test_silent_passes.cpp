@@ -14,6 +14,7 @@
 #include "harness/runner.h"
 #include "harness/suite.h"
 #include "metrics/image_io.h"
+#include "tests/furnace_store.h"
 #include "tests/test_support.h"
 
 namespace fs = std::filesystem;
@@ -75,25 +76,11 @@ const char* kMiniSuite = R"({
                "reference_band": {"flip.mean": {"below": 0.2, "above": 0.1}}},
   "tests": [{"scene": "furnace", "method": "mobile"}]
 })";
-const std::string kMiniTest = "mobile.furnace.constant:1.default";
+const std::string& kMiniTest = kFurnaceTest;
 
 // A private golden root: the furnace's reference golden and a freshly blessed baseline.
-struct Mini {
-    fs::path dir, suite, goldens;
-    explicit Mini(const std::string& name) : dir(temp_dir(name)), suite(dir / "mini.json"), goldens(dir / "goldens") {
-        write_file(suite, kMiniSuite);
-        fs::create_directories(goldens / "reference");
-        for (const char* ext : {".exr", ".json"})
-            fs::copy(fs::path(IBLCHECK_SOURCE_DIR) / (std::string("goldens/reference/furnace__constant-1") + ext),
-                     goldens / "reference");
-        BlessOptions b;
-        b.suite = suite.string();
-        b.goldens = goldens;
-        EXPECT_EQ(bless(b), kExitPass);
-    }
-    ~Mini() { fs::remove_all(dir); }
-    fs::path baseline() const { return GoldenStore(goldens).baseline_path(kMiniTest); }
-    fs::path sidecar() const { return fs::path(baseline()).replace_extension(".json"); }
+struct Mini : FurnaceStore {
+    explicit Mini(const std::string& name) : FurnaceStore(name, kMiniSuite) { EXPECT_EQ(bless_all(), kExitPass); }
     fs::path reference() const { return goldens / "reference" / "furnace__constant-1.exr"; }
     // The one test's verdict and message; the run's exit code in `exit_code`.
     json run(int& exit_code) const {

@@ -197,7 +197,8 @@ TEST(ShaderCompiler, EveryPipelineShaderIsReusedFromTheCache) {
     // back whole from its entry: none is compiled again on every run.
     fs::path dir = temp_dir("validcache");
     setenv("IBLCHECK_CACHE_DIR", (dir / "cache").c_str(), 1);
-    const vk::Defines defaults = glsl_defines(shader_selections(OptionMap{}, "mobile"));
+    vk::Defines defaults = glsl_defines(shader_selections(OptionMap{}, "mobile"));
+    defaults.merge(glsl_defines(shader_selections(OptionMap{}, "sampled"))); // shade_sampled.comp's mip_clamp
     OptionMap fragment;
     fragment.set("shading", "fragment");
     const vk::Defines fragment_defaults = glsl_defines(shader_selections(fragment, "mobile"));

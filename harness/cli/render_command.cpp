@@ -116,14 +116,7 @@ void register_render_command(CLI::App& app, int& exit_code) {
         vk::ContextOptions vo;
         vo.device = device;
         Renderer renderer(vo);
-        RenderResult r;
-        try {
-            r = renderer.render(spec);
-        } catch (const NonFiniteRender& e) { // NaN/Inf coverage: the shader's fault, a regression (exit 1)
-            fmt::print(stderr, "error: {} {} under {}: {}\n", method, scene, env, e.what());
-            exit_code = kExitRegression;
-            return;
-        }
+        const RenderResult r = renderer.render(spec);
         // With --json - the JSON owns stdout; the human-readable lines go to stderr.
         FILE* human = json_out == "-" ? stderr : stdout;
         print_render_summary(human, r);
@@ -133,10 +126,15 @@ void register_render_command(CLI::App& app, int& exit_code) {
             fmt::print(human, "wrote {} and {}\n", out, png.string());
         }
         if (!json_out.empty()) write_render_json(json_out, render_json(r));
-        // Non-finite pixels are the shader's fault: a regression (exit 1), after the files are
-        // written so the pixels can be inspected.
+        // Non-finite pixels or coverage are the shader's fault: a regression (exit 1), after the
+        // files are written so the pixels can be inspected.
         if (NonFinite nf = find_non_finite(r.image); nf.count) {
             fmt::print(stderr, "error: {} {} under {}: the render has {}\n", method, scene, env, nf.describe());
+            exit_code = kExitRegression;
+            return;
+        }
+        if (!r.non_finite_coverage.empty()) { // NaN/Inf coverage: the shader's fault too
+            fmt::print(stderr, "error: {} {} under {}: {}\n", method, scene, env, r.non_finite_coverage);
             exit_code = kExitRegression;
             return;
         }

@@ -79,7 +79,7 @@ FragmentShadingResult shade_fragment(GpuSession& gpu, const FragmentShadingPass&
     FragmentShadingResult r;
     for (auto& [name, ms] : timer.results()) r.timings.push_back({name, ms, true, false});
     const float* rgba = out.as<float>();
-    check_coverage_finite(rgba, int(fw), int(fh), ssaa, "shade_spheres.frag");
+    r.non_finite_coverage = coverage_problem(rgba, int(fw), int(fh), ssaa, "shade_spheres.frag");
     r.coverage = box_downsample_rgba(rgba, width, height, ssaa, r.image);
     size_t shaded = 0;
     for (size_t i = 0; i < size_t(fw) * fh; ++i) shaded += rgba[4 * i + 3] > 0.0f;

@@ -34,6 +34,7 @@ struct FragmentShadingResult {
     // SPIR-V instructions the draw executed (vertex + fragment invocations, helpers excepted:
     // they cannot write the counter) per image pixel; nullopt where the device cannot count.
     std::optional<double> instructions_per_pixel;
+    std::string non_finite_coverage; // coverage_problem() of the samples (RenderResult's)
 };
 
 // EnvironmentError when the device cannot draw it (graphics queue, 4x MSAA, standard sample

@@ -72,21 +72,22 @@ vk::Buffer upload_scene(vk::Context& ctx, const Scene& scene) {
     return buf;
 }
 
-void check_coverage_finite(const float* rgba, int width, int height, int ssaa, const std::string& shader) {
+std::string coverage_problem(const float* rgba, int width, int height, int ssaa, const std::string& shader) {
     size_t count = 0;
     int first_x = -1, first_y = -1;
     for (int y = 0; y < height; ++y)
         for (int x = 0; x < width; ++x)
             if (!std::isfinite(rgba[4 * (size_t(y) * width + x) + 3]) && count++ == 0) first_x = x / ssaa, first_y = y / ssaa;
-    if (count)
-        throw NonFiniteRender(fmt::format("{}: alpha (coverage) channel: {} non-finite value(s) (NaN/Inf), first at x={}, y={}",
-                                          shader, count, first_x, first_y));
+    if (!count) return {};
+    return fmt::format("{}: alpha (coverage) channel: {} non-finite value(s) (NaN/Inf), first at x={}, y={}", shader, count,
+                       first_x, first_y);
 }
 
-double read_back_image(const vk::Buffer& buf, int width, int height, cv::Mat& rgb, const std::string& shader) {
+double read_back_image(const vk::Buffer& buf, int width, int height, cv::Mat& rgb, const std::string& shader,
+                       std::string& problem) {
     rgb.create(height, width, CV_32FC3);
     const float* src = static_cast<const float*>(buf.mapped);
-    check_coverage_finite(src, width, height, 1, shader);
+    problem = coverage_problem(src, width, height, 1, shader);
     double coverage = 0;
     for (int y = 0; y < height; ++y) {
         float* row = rgb.ptr<float>(y);

@@ -122,6 +122,7 @@ struct ShadingInputs {
 std::optional<double> shade_with_fragments(GpuSession& gpu, const ShadingInputs& in, RenderResult& result) {
     FragmentShadingResult f = shade_fragment(gpu, {in.defines, in.options, in.bindings, in.push, in.sphere_count});
     result.image = f.image;
+    result.non_finite_coverage = f.non_finite_coverage;
     result.timings.insert(result.timings.end(), f.timings.begin(), f.timings.end());
     result.texture_fetches_per_pixel = f.shaded_fragments_per_pixel * in.per_hit;
     return f.instructions_per_pixel;
@@ -139,7 +140,7 @@ std::optional<double> shade_with_compute(GpuSession& gpu, const ShadingInputs& i
     const ShadePush& pc = in.push;
     for (auto& [name, ms] : shade.dispatch_timed("shade_spheres", b, &pc, sizeof pc, (width + 7) / 8, (height + 7) / 8))
         result.timings.push_back({name, ms, true, false});
-    double coverage = read_back_image(out, width, height, result.image, "shade_spheres.comp");
+    double coverage = read_back_image(out, width, height, result.image, "shade_spheres.comp", result.non_finite_coverage);
     // One shading per ray that hits.
     result.texture_fetches_per_pixel = coverage * pc.ssaa * pc.ssaa * in.per_hit;
     return shading_instructions_per_pixel(

@@ -55,7 +55,7 @@ RenderResult render_sampled(GpuSession& gpu, const Environment& env, const TestS
                                   vk::Binding::storage_buffer(5, out)};
     for (auto& [name, ms] : shade.dispatch_timed("shade_sampled", b, &pc, sizeof pc, (width + 7) / 8, (height + 7) / 8))
         result.timings.push_back({name, ms, true, false});
-    double coverage = read_back_image(out, width, height, result.image, "shade_sampled.comp");
+    double coverage = read_back_image(out, width, height, result.image, "shade_sampled.comp", result.non_finite_coverage);
     result.texture_fetches_per_pixel = coverage * pc.ssaa * pc.ssaa * samples;
     auto instructions =
         shading_instructions_per_pixel(gpu, {"shade_sampled.comp", defines, types, {}, b, 5, &pc, sizeof pc, width, height}, out);
