@@ -30,8 +30,8 @@ const std::vector<OptionInfo>& option_catalog() {
          "levels of the prefiltered chain; by default all the layout holds (cube: down to 1x1); a count whose last level is "
          "below r = 1 (UE4's curve reaches it at mip log2(cube_size)-2) is refused"},
         {"prefilter_samples", "256", "1..65536", "mobile", "",
-         "GGX samples per prefiltered texel (filtered importance sampling); 256 leaves under 1 % of the error against the truth "
-         "to the prefilter's noise (64: 6 %)"},
+         "GGX samples per prefiltered texel (filtered importance sampling); against a 4096-sample bake, the noise is under 1 % "
+         "of the default's error against the truth in studio, sunrise and interior and 3 % in sky_sun (64: up to 6 %)"},
         {"shading", "compute", "compute|fragment", "mobile", "SHADING",
          "compute: each pixel ray-traces the spheres, specular AA from neighbouring rays; fragment: sphere impostors "
          "in a graphics pipeline, MSAA 4x, specular AA from the hardware quads' dFdx/dFdy"},
