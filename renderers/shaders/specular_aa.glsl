@@ -32,8 +32,10 @@ float rjump_kernel(vec3 dr_dx, vec3 dr_dy, float variance) {
 }
 // Toksvig 2005, "Mipmapping Normal Maps": the mean of the normals over the pixel footprint is
 // shorter than 1 where they disagree; α'² = α² + (1 − |n̄|)/|n̄| (the GGX form in Hill's "Specular
-// Showdown"), scaled by σ²/0.25 so the variance option means the same for every variant.
-// `sum`: the sum of four unit normals spread over the pixel.
+// Showdown"), scaled by σ²/0.25. Toksvig's own relation (s' = s/(1 + sσ_T²), s ≈ 2/α²) adds twice
+// that, which this applies at σ² = 0.5; and σ² does not mean what it means for tokuyoshi: on a
+// normal varying linearly across the pixel this adds 1/16 of tokuyoshi's α² at the same σ²
+// (tests/test_specular_aa_kernel.cpp). `sum`: the sum of four unit normals spread over the pixel.
 float toksvig_kernel(vec3 sum, float variance) {
     float len = length(sum * 0.25);
     return 4.0 * variance * (1.0 - len) / max(len, 1e-4);  // = σ² at the default variance 0.25
