@@ -66,6 +66,13 @@ Probe probe(const LinearNormal& s) {
     return p;
 }
 
+std::vector<Probe> probes(const std::vector<LinearNormal>& cases) {
+    std::vector<Probe> p;
+    p.reserve(cases.size());
+    for (const LinearNormal& c : cases) p.push_back(probe(c));
+    return p;
+}
+
 const char* kProbeShader = R"(#version 460
 layout(local_size_x = 64) in;
 struct Probe { vec4 n, dn_dx, dn_dy, dr_dx, dr_dy, params; };
@@ -152,6 +159,7 @@ std::vector<LinearNormal> one_axis_cases() {
 // Tokuyoshi & Kaplanyan's per-axis relation on a Gaussian footprint of variance σ²: α² + 2σ²|a|².
 std::vector<double> gaussian_axis_alpha2(const std::vector<LinearNormal>& cases) {
     std::vector<double> e;
+    e.reserve(cases.size());
     for (const LinearNormal& s : cases) e.push_back(base_alpha2(s) + 2 * s.variance * trace_per_variance(s));
     return e;
 }
@@ -160,6 +168,7 @@ std::vector<double> gaussian_axis_alpha2(const std::vector<LinearNormal>& cases)
 // α² + (σ²/0.5)·tr Σ₄ to leading order; the exact |n̄| of the four normals, not the expansion.
 std::vector<double> toksvig_alpha2(const std::vector<LinearNormal>& cases) {
     std::vector<double> e;
+    e.reserve(cases.size());
     for (const LinearNormal& s : cases) {
         double len = 0; // |n̄|: the four slopes ±a/4 ± b/4 each give n·n0 = 1/√(1 + |slope|²)
         for (double i : {-0.25, 0.25})
@@ -177,39 +186,37 @@ std::vector<double> toksvig_alpha2(const std::vector<LinearNormal>& cases) {
 
 TEST(SpecularAaKernel, TokuyoshiMatchesTheGaussianFootprintAlongOneAxis) {
     const auto cases = one_axis_cases();
-    std::vector<Probe> p;
-    for (const auto& c : cases) p.push_back(probe(c));
+    const std::vector<Probe> p = probes(cases);
     expect_increments(widened_alpha2("tokuyoshi", p), cases, gaussian_axis_alpha2(cases), "tokuyoshi");
 }
 
 TEST(SpecularAaKernel, TokuyoshiIsTwiceTheWidestAxisForIsotropicVariation) {
     // a ⟂ b, |a| = |b|: every axis has λ = σ²|a|², the isotropic kernel adds 2σ²·2|a|².
     std::vector<LinearNormal> cases = {{{0.05, 0, 0}, {0, 0.05, 0}}, {{0.1, 0, 0}, {0, 0.1, 0}, {0, 0, 1}, 0.05, 1.0 / 12.0}};
-    std::vector<Probe> p;
-    std::vector<double> twice;
-    for (const auto& c : cases) p.push_back(probe(c)), twice.push_back(base_alpha2(c) + 2 * 2 * c.variance * dot(c.a, c.a));
-    expect_increments(widened_alpha2("tokuyoshi", p), cases, twice, "tokuyoshi, isotropic");
+    std::vector<double> twice(cases.size());
+    for (size_t i = 0; i < cases.size(); ++i)
+        twice[i] = base_alpha2(cases[i]) + 2 * 2 * cases[i].variance * dot(cases[i].a, cases[i].a);
+    expect_increments(widened_alpha2("tokuyoshi", probes(cases)), cases, twice, "tokuyoshi, isotropic");
 }
 
 TEST(SpecularAaKernel, RjumpMatchesTheFootprintInThePlaneOfIncidence) {
     auto cases = one_axis_cases();
     for (auto& c : cases) c.v = {std::sin(1.0), 0, std::cos(1.0)}; // 57° off the normal, tilted along x as a is
     cases.push_back({{0.08, 0, 0}, {0, 0, 0}});                    // normal incidence
-    std::vector<Probe> p;
-    for (const auto& c : cases) p.push_back(probe(c));
+    const std::vector<Probe> p = probes(cases);
     expect_increments(widened_alpha2("rjump", p), cases, gaussian_axis_alpha2(cases), "rjump");
 }
 
 TEST(SpecularAaKernel, RjumpIsCosSquaredOfTheFootprintAcrossThePlaneOfIncidence) {
-    std::vector<LinearNormal> cases;
-    std::vector<double> expected;
-    for (double theta : {0.5, 1.0, 1.3}) {
-        LinearNormal c{{0, 0.1, 0}, {0, 0, 0}, {std::sin(theta), 0, std::cos(theta)}};
-        cases.push_back(c);
-        expected.push_back(base_alpha2(c) + std::pow(std::cos(theta), 2) * 2 * c.variance * dot(c.a, c.a));
+    const std::array<double, 3> thetas = {0.5, 1.0, 1.3};
+    std::vector<LinearNormal> cases(thetas.size());
+    std::vector<double> expected(thetas.size());
+    for (size_t i = 0; i < thetas.size(); ++i) {
+        cases[i] = {{0, 0.1, 0}, {0, 0, 0}, {std::sin(thetas[i]), 0, std::cos(thetas[i])}};
+        expected[i] =
+            base_alpha2(cases[i]) + std::pow(std::cos(thetas[i]), 2) * 2 * cases[i].variance * dot(cases[i].a, cases[i].a);
     }
-    std::vector<Probe> p;
-    for (const auto& c : cases) p.push_back(probe(c));
+    const std::vector<Probe> p = probes(cases);
     expect_increments(widened_alpha2("rjump", p), cases, expected, "rjump, across the plane");
 }
 
@@ -217,8 +224,7 @@ TEST(SpecularAaKernel, ToksvigIsToksvigsRelationOnItsFourNormals) {
     auto cases = one_axis_cases();
     cases.push_back({{0.1, 0, 0}, {0, 0.1, 0}, {0, 0, 1}, 0.05, 0.5}); // isotropic, at σ² = 0.5: Toksvig's own
     cases.push_back({{0.06, 0.03, 0}, {-0.02, 0.09, 0}, {0, 0, 1}, 0.05, 0.25});
-    std::vector<Probe> p;
-    for (const auto& c : cases) p.push_back(probe(c));
+    const std::vector<Probe> p = probes(cases);
     const auto got = widened_alpha2("toksvig", p);
     expect_increments(got, cases, toksvig_alpha2(cases), "toksvig");
     // Its footprint in second moment: α² + (σ²/0.5) tr Σ₄ = α² + (σ²/0.5)(|a|² + |b|²)/16, within
@@ -240,8 +246,7 @@ TEST(SpecularAaKernel, ThresholdClampsTheAddedAlpha2) {
 // The tests above reject a kernel scaled by 2 or by 0: the same comparisons on broken shaders.
 TEST(SpecularAaKernel, BrokenKernelsMissTheAnalyticFootprint) {
     const auto cases = one_axis_cases();
-    std::vector<Probe> p;
-    for (const auto& c : cases) p.push_back(probe(c));
+    const std::vector<Probe> p = probes(cases);
     struct Variant {
         const char *name, *kernel;
         std::vector<double> expected;
