@@ -29,6 +29,8 @@ void note_worst_block(Comparison& c, const SphereCoverage& coverage, const FlipR
                                  sphere.empty() ? "" : " on " + sphere, flip.block_max);
 }
 
+const DisplaySpace* display_of(const TestCase& tc) { return tc.display ? &*tc.display : nullptr; }
+
 BaselineOutcome missing_baseline(const TestCase& tc, const GoldenStore& store) {
     BaselineOutcome out;
     out.missing = true;
@@ -45,7 +47,7 @@ Comparison judge_against_baseline(const TestCase& tc, const RenderResult& rr, co
     const cv::Mat& image = rr.image;
     if (g.image.size() != image.size()) return judge_size("baseline", image.cols, image.rows, g.image.cols, g.image.rows);
     FlipResult flip;
-    Comparison c = judge_baseline(compare_images(g.image, image, flip_threads, &flip), tc.baseline_tolerances);
+    Comparison c = judge_baseline(compare_images(g.image, image, flip_threads, &flip, display_of(tc)), tc.baseline_tolerances);
     note_worst_block(c, rr.coverage, flip);
     if (art) {
         std::string tag = g.label.empty() ? "baseline" : "baseline@" + safe_file_name(g.label);
@@ -115,7 +117,7 @@ Comparison judge_against_truth(const TestCase& tc, const RenderResult& rr, const
         return c;
     }
     FlipResult flip;
-    json metrics = compare_images(ref.image, image, flip_threads, &flip);
+    json metrics = compare_images(ref.image, image, flip_threads, &flip, display_of(tc));
     Comparison c = judge_reference(metrics, approved_accuracy, tc.reference_band);
     c.golden = store.relative(ref.image_path);
     note_worst_block(c, rr.coverage, flip);
@@ -123,6 +125,11 @@ Comparison judge_against_truth(const TestCase& tc, const RenderResult& rr, const
                      {"ssim", metrics["ssim"]["mean"]},
                      {"golden", c.golden},
                      {"noise_floor", ref.provenance.value("noise_floor", json())}};
+    if (tc.display) // the truth as a player sees it: LDR-FLIP, SSIM and PSNR of both after the display
+        r["accuracy"]["display"] = {{"space", metrics["display"]},
+                                    {"flip_mean", metrics["display_flip"]["mean"]},
+                                    {"ssim", metrics["display_ssim"]["mean"]},
+                                    {"psnr_db", metrics["display_psnr"]["db"]}};
     if (json ps = per_sphere_errors(rr.coverage, flip.errmap); !ps.is_null()) r["per_sphere"] = ps;
     if (art) {
         c.images = Artefacts::images(art.rel + "test.png", art.png("reference.png", ref.image, false),
