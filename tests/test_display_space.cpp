@@ -14,6 +14,7 @@
 #include "harness/verdict.h"
 #include "metrics/display_space.h"
 #include "metrics/display_transform.h"
+#include "reports/report_html.h"
 #include "tests/test_support.h"
 
 namespace fs = std::filesystem;
@@ -313,4 +314,40 @@ TEST(DisplayScores, CiDisplayTestsFailAChangeVisibleOnTheDisplay) {
     }
     EXPECT_EQ(display_tests, 2);
     EXPECT_GT(white_pixels, 1000u); // the highlight check changed something
+}
+
+// The nightly's chart: one panel per scene, environment and space, a point per test at (linear
+// HDR-FLIP, display LDR-FLIP) vs the truth, and the measured change of the ranking under it.
+TEST(DisplayChart, PanelsPlotLinearAgainstDisplayAndStateTheRankChange) {
+    using report::html::spearman_rho;
+    EXPECT_DOUBLE_EQ(spearman_rho({0.1, 0.2, 0.3}, {1, 5, 9}), 1.0);
+    EXPECT_DOUBLE_EQ(spearman_rho({0.1, 0.2, 0.3}, {9, 5, 1}), -1.0);
+    EXPECT_NEAR(spearman_rho({1, 2, 3, 4}, {1, 3, 2, 4}), 0.8, 1e-12); // 1 − 6·2/(4·15)
+    EXPECT_TRUE(std::isnan(spearman_rho({1, 2}, {3, 3})));
+    const nlohmann::json space = {{"tonemap", "pbr_neutral"}, {"exposure", 0}, {"quantize", "srgb8"}, {"target", "rgba16f"}};
+    std::vector<nlohmann::json> tests;
+    const double lin[] = {0.1, 0.2, 0.3, 0.4, 0.5}, dis[] = {0.05, 0.04, 0.03, 0.02, 0.06};
+    for (int i = 0; i < 5; ++i)
+        tests.push_back({{"name", "mobile.roughness_sweep.studio.v" + std::to_string(i)},
+                         {"method", "mobile"},
+                         {"scene", "roughness_sweep"},
+                         {"env", "studio"},
+                         {"variant", "v" + std::to_string(i)},
+                         {"accuracy", {{"flip_mean", lin[i]}, {"display", {{"space", space}, {"flip_mean", dis[i]}}}}}});
+    tests.push_back({{"name", "linear.only"}, {"method", "mobile"}, {"accuracy", {{"flip_mean", 0.1}}}});
+    std::vector<const nlohmann::json*> ptrs;
+    for (const auto& t : tests) ptrs.push_back(&t);
+    const std::string html = report::html::display_section(ptrs);
+    EXPECT_NE(html.find("data-chart=\"linear-display-roughness-sweep-studio-pbr-neutral-0-EV-srgb8-rgba16f\" data-points=\"5\""),
+              std::string::npos)
+        << html.substr(0, 2000);
+    // Ranks by linear 1..5; by display 4, 3, 2, 1, 5: ρ = 1 − 6·(9+1+1+9+0)/(5·24) = 0.
+    EXPECT_NE(html.find("Spearman \u03c1 = 0.00 over 5 tests; 2 move 3 or more places; largest: mobile v0 (linear #1 "
+                        "\u2192 display #4), mobile v3 (linear #4 \u2192 display #1)"),
+              std::string::npos)
+        << html.substr(0, 3000);
+    EXPECT_EQ(report::html::display_section({ptrs.back()}), ""); // nothing scored in a display space: no section
+    const std::string one = report::html::display_section({ptrs.front()});
+    EXPECT_NE(one.find("No scene, environment and space has two tests scored in it."), std::string::npos) << one;
+    EXPECT_EQ(one.find("data-chart="), std::string::npos) << one;
 }
