@@ -8,6 +8,7 @@
 #include <filesystem>
 
 #include "harness/common/errors.h"
+#include "harness/golden_comparisons.h"
 #include "harness/golden_store.h"
 #include "harness/image_compare.h"
 #include "harness/suite.h"
@@ -314,6 +315,25 @@ TEST(DisplayScores, CiDisplayTestsFailAChangeVisibleOnTheDisplay) {
     }
     EXPECT_EQ(display_tests, 2);
     EXPECT_GT(white_pixels, 1000u); // the highlight check changed something
+}
+
+// A display test's failure is located where its tolerances looked: the worst block and the heatmap
+// of its baseline comparison come from the LDR-FLIP map on the display, and say so.
+TEST(DisplayScores, ADisplayTestsWorstBlockIsFoundOnTheDisplay) {
+    const Suite ci = load_suite("ci");
+    const GoldenStore store;
+    for (const TestCase& tc : ci.tests) {
+        if (!tc.display) continue;
+        RenderResult rr;
+        rr.image = store.baselines(tc.name).at(0).image * 1.04;
+        rr.coverage.ids = cv::Mat(rr.image.size(), CV_32S, cv::Scalar(-1));
+        const BaselineOutcome b = judge_against_baselines(tc, rr, store, Artefacts{}, 1);
+        ASSERT_EQ(b.comparison.verdict, Verdict::fail) << tc.name;
+        EXPECT_EQ(b.comparison.worst_block["metric"], "display_flip");
+        EXPECT_EQ(b.comparison.worst_block["flip"], b.comparison.metrics["display_flip"]["block_max"]);
+        EXPECT_NE(b.comparison.worst_block["flip"], b.comparison.metrics["flip"]["block_max"]);
+        EXPECT_NE(b.comparison.message.find("with mean LDR-FLIP on the display"), std::string::npos) << b.comparison.message;
+    }
 }
 
 // The nightly's chart: one panel per scene, environment and space, a point per test at (linear
