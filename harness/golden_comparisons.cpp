@@ -18,15 +18,36 @@ namespace iblcheck {
 namespace {
 
 // Where the error concentrates, for a person: "worst 16x16 block at (160,16) on metal r=0.3 ...".
-// Recorded on the comparison ({x, y, flip, sphere}); a failing comparison's message says it too.
-// The sphere is the one the render shows at the block's centre (its coverage).
-void note_worst_block(Comparison& c, const SphereCoverage& coverage, const FlipResult& flip) {
+// Recorded on the comparison ({x, y, flip, metric, sphere}); a failing comparison's message says it
+// too. The sphere is the one the render shows at the block's centre (its coverage). `metric`: the
+// FLIP map it was found in, "flip" (linear HDR) or "display_flip" (LDR-FLIP on a test's display).
+void note_worst_block(Comparison& c, const SphereCoverage& coverage, const FlipResult& flip, bool display) {
     const int width = coverage.ids.cols, height = coverage.ids.rows;
     std::string sphere = sphere_at(coverage, std::min(flip.block_x + 8, width - 1), std::min(flip.block_y + 8, height - 1));
-    c.worst_block = {{"x", flip.block_x}, {"y", flip.block_y}, {"flip", flip.block_max}, {"sphere", sphere}};
+    c.worst_block = {{"x", flip.block_x},
+                     {"y", flip.block_y},
+                     {"flip", flip.block_max},
+                     {"metric", display ? "display_flip" : "flip"},
+                     {"sphere", sphere}};
     if (c.verdict == Verdict::fail)
-        c.message += fmt::format("; worst 16x16 block at ({},{}){} with mean FLIP {:.4g}", flip.block_x, flip.block_y,
-                                 sphere.empty() ? "" : " on " + sphere, flip.block_max);
+        c.message +=
+            fmt::format("; worst 16x16 block at ({},{}){} with mean {} {:.4g}", flip.block_x, flip.block_y,
+                        sphere.empty() ? "" : " on " + sphere, display ? "LDR-FLIP on the display" : "FLIP", flip.block_max);
+}
+
+// The metrics of a render against a golden. `linear` receives the HDR-FLIP result (the accuracy and
+// the per-sphere errors are linear figures); `shown`, the FLIP map that locates the difference for
+// the worst block and the heatmap: a display test's LDR-FLIP on its display (what its tolerances
+// judge), else the same HDR-FLIP.
+json measure(const TestCase& tc, const cv::Mat& golden, const cv::Mat& image, int flip_threads, FlipResult& linear,
+             FlipResult& shown) {
+    json m = compare_images(golden, image, flip_threads, &linear);
+    if (!tc.display) {
+        shown = linear;
+        return m;
+    }
+    m.update(compare_in_display(golden, image, *tc.display, flip_threads, &shown));
+    return m;
 }
 
 BaselineOutcome missing_baseline(const TestCase& tc, const GoldenStore& store) {
@@ -44,9 +65,9 @@ Comparison judge_against_baseline(const TestCase& tc, const RenderResult& rr, co
                                   int flip_threads) {
     const cv::Mat& image = rr.image;
     if (g.image.size() != image.size()) return judge_size("baseline", image.cols, image.rows, g.image.cols, g.image.rows);
-    FlipResult flip;
-    Comparison c = judge_baseline(compare_images(g.image, image, flip_threads, &flip), tc.baseline_tolerances);
-    note_worst_block(c, rr.coverage, flip);
+    FlipResult linear, flip;
+    Comparison c = judge_baseline(measure(tc, g.image, image, flip_threads, linear, flip), tc.baseline_tolerances);
+    note_worst_block(c, rr.coverage, flip, tc.display.has_value());
     if (art) {
         std::string tag = g.label.empty() ? "baseline" : "baseline@" + safe_file_name(g.label);
         // A render bit-identical to its baseline (the usual pass) shares the test's EXR.
@@ -114,19 +135,24 @@ Comparison judge_against_truth(const TestCase& tc, const RenderResult& rr, const
         c.golden = store.relative(ref.image_path);
         return c;
     }
-    FlipResult flip;
-    json metrics = compare_images(ref.image, image, flip_threads, &flip);
+    FlipResult flip, shown;
+    json metrics = measure(tc, ref.image, image, flip_threads, flip, shown);
     Comparison c = judge_reference(metrics, approved_accuracy, tc.reference_band);
     c.golden = store.relative(ref.image_path);
-    note_worst_block(c, rr.coverage, flip);
+    note_worst_block(c, rr.coverage, shown, tc.display.has_value());
     r["accuracy"] = {{"flip_mean", flip.mean},
                      {"ssim", metrics["ssim"]["mean"]},
                      {"golden", c.golden},
                      {"noise_floor", ref.provenance.value("noise_floor", json())}};
+    if (tc.display) // the truth as a player sees it: LDR-FLIP, SSIM and PSNR of both after the display
+        r["accuracy"]["display"] = {{"space", metrics["display"]},
+                                    {"flip_mean", metrics["display_flip"]["mean"]},
+                                    {"ssim", metrics["display_ssim"]["mean"]},
+                                    {"psnr_db", metrics["display_psnr"]["db"]}};
     if (json ps = per_sphere_errors(rr.coverage, flip.errmap); !ps.is_null()) r["per_sphere"] = ps;
     if (art) {
         c.images = Artefacts::images(art.rel + "test.png", art.png("reference.png", ref.image, false),
-                                     art.heatmap("reference_flip.png", flip.errmap));
+                                     art.heatmap("reference_flip.png", shown.errmap));
         c.images["golden_exr"] = art.shared_exr(c.golden, ref.image);
     }
     return c;

@@ -11,19 +11,39 @@ using nlohmann::json;
 
 namespace iblcheck {
 
-json compare_images(const cv::Mat& golden, const cv::Mat& test, int flip_threads, FlipResult* flip_out) {
+namespace {
+json ssim_not_applicable() { return {{"mean", nullptr}, {"not_applicable", "smaller than SSIM's 11x11 window"}}; }
+// Identical images have PSNR +inf, which JSON cannot hold: 999 stands for it.
+json psnr_json(const PsnrResult& p) {
+    return {{"db", std::isfinite(p.db) ? json(p.db) : json(999.0)}, {"rmse", p.rmse}, {"max_abs", p.max_abs}};
+}
+} // namespace
+
+json compare_in_display(const cv::Mat& golden, const cv::Mat& test, const DisplaySpace& display, int flip_threads,
+                        FlipResult* flip_out) {
+    const cv::Mat g = to_display(golden, display), t = to_display(test, display);
+    FlipOptions fo;
+    fo.threads = flip_threads;
+    FlipResult f = compute_flip_ldr(g, t, fo);
+    json j = {{"display", display_json(display)},
+              {"display_flip", flip_json(f)},
+              {"display_ssim", ssim_applicable(g) ? json{{"mean", compute_ssim(g, t).mean}} : ssim_not_applicable()},
+              {"display_psnr", psnr_json(compute_psnr(g, t))}};
+    if (flip_out) *flip_out = std::move(f);
+    return j;
+}
+
+json compare_images(const cv::Mat& golden, const cv::Mat& test, int flip_threads, FlipResult* flip_out,
+                    const DisplaySpace* display) {
     FlipOptions fo;
     fo.threads = flip_threads;
     FlipResult f = compute_flip_hdr(golden, test, fo);
     PsnrResult p = compute_psnr(display_transform(golden), display_transform(test));
     json j;
     j["flip"] = flip_json(f);
-    if (ssim_applicable(golden))
-        j["ssim"] = {{"mean", compute_ssim_hdr(golden, test).mean}};
-    else
-        j["ssim"] = {{"mean", nullptr}, {"not_applicable", "smaller than SSIM's 11x11 window"}};
-    // Identical images have PSNR +inf, which JSON cannot hold: 999 stands for it.
-    j["psnr"] = {{"db", std::isfinite(p.db) ? json(p.db) : json(999.0)}, {"rmse", p.rmse}, {"max_abs", p.max_abs}};
+    j["ssim"] = ssim_applicable(golden) ? json{{"mean", compute_ssim_hdr(golden, test).mean}} : ssim_not_applicable();
+    j["psnr"] = psnr_json(p);
+    if (display) j.update(compare_in_display(golden, test, *display, flip_threads));
     if (flip_out) *flip_out = std::move(f);
     return j;
 }

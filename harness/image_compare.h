@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 
+#include "metrics/display_space.h"
 #include "metrics/flip.h"
 #include "renderers/render_api.h"
 
@@ -12,7 +13,16 @@ namespace iblcheck {
 
 // HDR-FLIP, SSIM (on the display transform; null with "not_applicable" under 11x11) and PSNR of
 // `test` against `golden` (same size, finite). `flip_out` receives the FLIP result with its map.
-nlohmann::json compare_images(const cv::Mat& golden, const cv::Mat& test, int flip_threads, FlipResult* flip_out = nullptr);
+// With a `display` (a test scored as a player sees it: metrics/display_space.h) the metrics also hold
+// the same figures in that space: "display" (the space), "display_flip" (LDR-FLIP),
+// "display_ssim" and "display_psnr", judged as display_flip.mean, display_ssim.mean, display_psnr.db.
+nlohmann::json compare_images(const cv::Mat& golden, const cv::Mat& test, int flip_threads, FlipResult* flip_out = nullptr,
+                              const DisplaySpace* display = nullptr);
+
+// LDR-FLIP, SSIM and PSNR of both images after to_display(`display`), as the groups above.
+// `flip_out` receives the LDR-FLIP result with its map.
+nlohmann::json compare_in_display(const cv::Mat& golden, const cv::Mat& test, const DisplaySpace& display, int flip_threads,
+                                  FlipResult* flip_out = nullptr);
 
 // Mean FLIP per sphere of a multi-sphere scene (null for single-sphere scenes), labelled with the
 // scene's sphere names. `coverage`: the render's (RenderResult::coverage), the error map's size.

@@ -15,7 +15,14 @@ using nlohmann::json;
 namespace iblcheck {
 
 namespace {
-const char* const kFloorMetrics[] = {"flip.mean", "flip.p99", "flip.block_max", "ssim.mean"};
+// The metrics whose noise floors are measured: a display test's display figures too (issue 29), so
+// its display tolerances get margins like the linear ones.
+std::vector<std::string> floor_metrics(const TestCase& tc) {
+    std::vector<std::string> m = {"flip.mean", "flip.p99", "flip.block_max", "ssim.mean"};
+    if (tc.display) m.insert(m.end(), {"display_flip.mean", "display_flip.p99", "display_flip.block_max", "display_ssim.mean"});
+    return m;
+}
+const DisplaySpace* display_of(const TestCase& tc) { return tc.display ? &*tc.display : nullptr; }
 
 bool bit_identical(const cv::Mat& a, const cv::Mat& b) {
     return a.size() == b.size() && a.type() == b.type() && std::memcmp(a.data, b.data, a.total() * a.elemSize()) == 0;
@@ -85,7 +92,7 @@ json sensitivity(const TestCase& tc, Worker& w, const cv::Mat& base, int flip_th
 
 double floor_of(const json& metrics, const std::string& metric) {
     double v = metric_value(metrics, metric);
-    return metric.rfind("ssim", 0) == 0 ? 1.0 - v : v;
+    return metric.rfind("ssim", 0) == 0 || metric.rfind("display_ssim", 0) == 0 ? 1.0 - v : v;
 }
 
 StabilityOutcome run_stability(const TestCase& tc, Worker& w, const cv::Mat& base, const cv::Mat& reference,
@@ -118,21 +125,22 @@ StabilityOutcome run_stability(const TestCase& tc, Worker& w, const cv::Mat& bas
             variants.emplace_back("cpu " + caps, c.image);
         }
     std::map<std::string, double> floor, seed_floor, cpu_floor;
-    json m_ref_base =
-        reference.empty() || reference.size() != base.size() ? json() : compare_images(reference, base, flip_threads);
+    json m_ref_base = reference.empty() || reference.size() != base.size()
+                          ? json()
+                          : compare_images(reference, base, flip_threads, nullptr, display_of(tc));
     for (const auto& [name, v] : variants) {
         const bool is_cpu = name.rfind("cpu ", 0) == 0;
         auto& kind_floor = is_cpu ? cpu_floor : seed_floor;
-        json m = compare_images(base, v, flip_threads);
+        json m = compare_images(base, v, flip_threads, nullptr, display_of(tc));
         if (is_cpu) {
             json& c = cpu[name.substr(4)];
-            for (const char* k : kFloorMetrics) c[k] = floor_of(m, k);
+            for (const std::string& k : floor_metrics(tc)) c[k] = floor_of(m, k);
         }
-        for (const char* k : kFloorMetrics) kind_floor[k] = std::max(kind_floor[k], floor_of(m, k));
+        for (const std::string& k : floor_metrics(tc)) kind_floor[k] = std::max(kind_floor[k], floor_of(m, k));
         if (!m_ref_base.is_null()) {
-            json mr = compare_images(reference, v, flip_threads);
-            for (const char* k : kFloorMetrics) {
-                std::string key = std::string("accuracy.") + k;
+            json mr = compare_images(reference, v, flip_threads, nullptr, display_of(tc));
+            for (const std::string& k : floor_metrics(tc)) {
+                std::string key = "accuracy." + k;
                 kind_floor[key] = std::max(kind_floor[key], std::fabs(metric_value(mr, k) - metric_value(m_ref_base, k)));
             }
         }

@@ -22,7 +22,9 @@ namespace iblcheck {
 
 namespace {
 
-const std::set<std::string> kMetrics = {"flip.mean", "flip.p99", "flip.block_max", "ssim.mean", "psnr.db"};
+const std::set<std::string> kMetrics = {"flip.mean",         "flip.p99",          "flip.block_max",   "ssim.mean",
+                                        "psnr.db",           "display_flip.mean", "display_flip.p99", "display_flip.block_max",
+                                        "display_ssim.mean", "display_psnr.db"};
 
 // The suite reader's checks: the shared ones (harness/common/json_check.h) plus options and bounds.
 struct Ctx : JsonChecker {
@@ -116,6 +118,42 @@ StabilitySpec parse_stability(const Ctx& c, const json& j, const std::string& wh
     return st;
 }
 
+// "display": the space a player sees (metrics/display_space.h). Every field is checked here, so
+// a misspelt tonemapper or an exposure of "NaN" is an error naming the suite file and the field.
+DisplaySpace parse_display(const Ctx& c, const json& j, const std::string& where) {
+    c.keys(j, where, {"tonemap", "exposure", "quantize", "target"});
+    if (!j.contains("tonemap")) c.fail(where + ".tonemap", "missing required key (aces_narkowicz or pbr_neutral)");
+    DisplaySpace d;
+    const std::string tm = c.str(j["tonemap"], where + ".tonemap");
+    if (auto t = parse_tonemap(tm))
+        d.tonemap = *t;
+    else
+        c.fail(where + ".tonemap", "unknown tonemapper '" + tm +
+                                       "'; valid: aces_narkowicz (Narkowicz's ACES fit, HDR-FLIP's curve), pbr_neutral "
+                                       "(Khronos PBR Neutral)");
+    if (j.contains("exposure")) {
+        d.exposure_ev = c.num(j["exposure"], where + ".exposure");
+        if (!(std::fabs(d.exposure_ev) <= kMaxDisplayExposure))
+            c.fail(where + ".exposure",
+                   fmt::format("must be a finite number of stops within ±{}, not {}", kMaxDisplayExposure, j["exposure"].dump()));
+    }
+    if (j.contains("quantize")) {
+        const std::string q = c.str(j["quantize"], where + ".quantize");
+        if (auto v = parse_quantize(q))
+            d.quantize = *v;
+        else
+            c.fail(where + ".quantize", "unknown quantisation '" + q + "'; valid: srgb8, none");
+    }
+    if (j.contains("target")) {
+        const std::string t = c.str(j["target"], where + ".target");
+        if (auto v = parse_target(t))
+            d.target = *v;
+        else
+            c.fail(where + ".target", "unknown render target '" + t + "'; valid: rgba32f, rgba16f, r11g11b10f");
+    }
+    return d;
+}
+
 void parse_size(const Ctx& c, const json& j, const std::string& where, int& w, int& h) {
     std::string s = c.str(j, where);
     if (std::sscanf(s.c_str(), "%dx%d", &w, &h) != 2 || w < 1 || h < 1 || w > 8192 || h > 8192)
@@ -180,13 +218,17 @@ struct SuiteDefaults {
     int width = 0, height = 0;
     std::map<std::string, Bound> bounds;
     std::map<std::string, Band> bands;
+    std::optional<DisplaySpace> display;
 };
 
 // "defaults": what every test inherits, plus the suite-wide jobs and timing_repeats.
 SuiteDefaults parse_defaults(const Ctx& c, const json& defaults, Suite& suite) {
     c.keys(defaults, "defaults",
-           {"env", "size", "jobs", "baseline_tolerances", "reference_band", "stability", "max_cost_growth", "timing_repeats"});
+           {"env", "size", "jobs", "baseline_tolerances", "reference_band", "stability", "max_cost_growth", "timing_repeats",
+            "display"});
     SuiteDefaults d;
+    if (defaults.contains("display") && !defaults["display"].is_null())
+        d.display = parse_display(c, defaults["display"], "defaults.display");
     if (defaults.contains("max_cost_growth")) d.max_cost_growth = c.num(defaults["max_cost_growth"], "defaults.max_cost_growth");
     if (defaults.contains("stability"))
         d.stability = parse_stability(c, defaults["stability"], "defaults.stability", d.stability);
@@ -242,7 +284,7 @@ struct TestEntry {
 TestEntry parse_test(const Ctx& c, const json& t, const std::string& w, const Suite& suite, const SuiteDefaults& d) {
     c.keys(t, w,
            {"scene", "method", "env", "size", "options", "variants", "baseline", "reference", "baseline_tolerances",
-            "reference_band", "tags", "temporal", "stability", "max_cost_growth", "tolerance_note", "measure_only"});
+            "reference_band", "tags", "temporal", "stability", "max_cost_growth", "tolerance_note", "measure_only", "display"});
     if (t.contains("tolerance_note")) c.str(t["tolerance_note"], w + ".tolerance_note");
     if (!t.contains("scene")) c.fail(w + ".scene", "missing required key");
     if (!t.contains("method")) c.fail(w + ".method", "missing required key");
@@ -294,6 +336,9 @@ TestEntry parse_test(const Ctx& c, const json& t, const std::string& w, const Su
     }
     proto.stability = t.contains("stability") ? parse_stability(c, t["stability"], w + ".stability", d.stability) : d.stability;
     if (t.contains("temporal")) proto.temporal = parse_temporal(c, t["temporal"], w + ".temporal");
+    proto.display = d.display;
+    if (t.contains("display"))
+        proto.display = t["display"].is_null() ? std::nullopt : std::optional(parse_display(c, t["display"], w + ".display"));
     return entry;
 }
 
@@ -320,6 +365,7 @@ void expand_test(const Ctx& c, const TestEntry& entry, const std::string& w, std
             for (auto& [k, v] : variant.values()) tc.spec.options.set(k, v);
             tc.variant = variant_name(tc.spec);
             tc.name = tc.spec.method + "." + tc.spec.scene + "." + env + "." + tc.variant;
+            if (tc.display) tc.name += ".display=" + display_label(*tc.display);
             try {
                 validate_spec(tc.spec);
                 if (tc.temporal.frames) validate_spec(temporal_reference_spec(tc));
@@ -342,6 +388,18 @@ bool judges_image(const TestCase& tc) {
     for (const auto& [metric, b] : tc.baseline_tolerances) bound |= b.min || b.max;
     const bool temporal = tc.temporal.frames > 0 && !tc.temporal.checks.empty();
     return (tc.baseline && bound) || (tc.baseline && tc.reference && !tc.reference_band.empty()) || temporal;
+}
+
+// A display_* bound on a test without a "display" would read a figure never measured (NaN: a
+// failure that says nothing about the render).
+void check_display_metrics(const Ctx& c, const TestCase& tc, const std::string& w) {
+    if (tc.display) return;
+    for (const auto& [metric, b] : tc.baseline_tolerances)
+        if (metric.rfind("display_", 0) == 0 && (b.min || b.max))
+            c.fail(w + ".baseline_tolerances." + metric, tc.name + " has no \"display\" to measure it in");
+    for (const auto& [metric, b] : tc.reference_band)
+        if (metric.rfind("display_", 0) == 0)
+            c.fail(w + ".reference_band." + metric, tc.name + " has no \"display\" to measure it in");
 }
 
 // A test that judges nothing passed whatever it rendered (issue 30); measure_only says so on purpose.
@@ -387,7 +445,10 @@ Suite load_suite(const std::string& name_or_path) {
         expand_test(c, parse_test(c, root["tests"][i], w, suite, defaults), w, goldens, suite);
         where.resize(suite.tests.size(), w);
     }
-    for (size_t k = 0; k < suite.tests.size(); ++k) check_judges_its_image(c, suite.tests[k], where[k]);
+    for (size_t k = 0; k < suite.tests.size(); ++k) {
+        check_display_metrics(c, suite.tests[k], where[k]);
+        check_judges_its_image(c, suite.tests[k], where[k]);
+    }
     if (suite.tests.empty()) c.fail("tests", "the suite has no tests");
     return suite;
 }

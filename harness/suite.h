@@ -3,6 +3,7 @@
 // environments and variants, and every combination is one test named
 //   <method>.<scene>.<env>.<options>      (options: "k=v,k=v" of all the test's options, then size=WxH when the
 //                                          test gives a size; "default" when neither)
+//   <method>.<scene>.<env>.<options>.display=<tonemap>_<ev>ev_<quantize>_<target>   (a test with a "display")
 //
 // Schema (keys marked * are required):
 // {
@@ -14,6 +15,8 @@
 //                "env": "studio" | ["studio", "sky_sun"], "size": "WxH",
 //                "options": {k: v}, "variants": [{k: v}, ...],
 //                "baseline": true, "reference": true, "measure_only": false,
+//                "display": {"tonemap"*: "aces_narkowicz" | "pbr_neutral", "exposure": 0, "quantize": "srgb8" | "none",
+//                            "target": "rgba32f" | "rgba16f" | "r11g11b10f"} | null,
 //                "baseline_tolerances": {...}, "reference_band": {...}, "max_cost_growth": 0.25, "tags": ["..."],
 //                "tolerance_note": "why this test's tolerances differ from the defaults (measured floors)",
 //                "temporal": {"frames": 32, "reference_ssaa": 8, "reference_options": {k: v},
@@ -22,8 +25,16 @@
 //                              "fail_on_flaky": false, "cpu_caps": ["avx", "sse4.1"]} } ]
 //                                                 ("stability" may also sit in "defaults")
 // }
-// METRIC is one of flip.mean, flip.p99, flip.block_max, ssim.mean, psnr.db; in a test, METRIC: null
-// drops a suite default (e.g. a percentile that seed noise alone saturates).
+// METRIC is one of flip.mean, flip.p99, flip.block_max, ssim.mean, psnr.db (linear HDR: HDR-FLIP over
+// exposures, SSIM and PSNR after ACES at exposure 0), or, for a test with a "display", the same figures
+// where a player sees them: display_flip.mean, display_flip.p99, display_flip.block_max (LDR-FLIP),
+// display_ssim.mean, display_psnr.db; in a test, METRIC: null drops a suite default (e.g. a
+// percentile that seed noise alone saturates).
+// "display" (metrics/display_space.h; in "defaults" or a test, whose own replaces the default's and
+// null drops it) scores the test as a player sees it: the render target's rounding (default
+// rgba32f: none), the exposure in EV (default 0), the tonemapper, the sRGB OETF and 8-bit
+// quantisation (default srgb8). It adds ".display=<tonemap>_<ev>ev_<quantize>_<target>" to the test's
+// name (its baseline's sidecar approves the display accuracy).
 // baseline_tolerances bound the difference to the approved baseline (deterministic renders: tight).
 // reference_band bounds the accuracy against the ground truth around the value approved at bless
 // time: [v·(1 − below) − abs, v·(1 + above) + abs]; under the band is `improved`, over it `fail`.
@@ -44,6 +55,7 @@
 #include <vector>
 
 #include "harness/verdict.h"
+#include "metrics/display_space.h"
 #include "renderers/render_api.h"
 
 namespace iblcheck {
@@ -89,7 +101,8 @@ struct TestCase {
     bool measure_only = false; // judges nothing of its image on purpose (suite.h's schema)
     std::map<std::string, Bound> baseline_tolerances;
     std::map<std::string, Band> reference_band;
-    double max_cost_growth = 0.25; // cost per pixel (SPIR-V instructions, texture fetches) vs the baseline's
+    double max_cost_growth = 0.25;       // cost per pixel (SPIR-V instructions, texture fetches) vs the baseline's
+    std::optional<DisplaySpace> display; // scored also as a player sees it (display_* metrics)
     std::vector<std::string> tags;
     TemporalSpec temporal;
     StabilitySpec stability;

@@ -32,6 +32,7 @@ json test_header(const TestCase& tc) {
             {"env", tc.spec.env},
             {"options", tc.spec.options.values()},
             {"variant", tc.variant},
+            {"display", tc.display ? display_json(*tc.display) : json()},
             {"tags", tc.tags},
             {"bless_command", bless_command(tc)},
             {"comparisons", json::array()},

@@ -47,6 +47,7 @@ bool is_regression(Verdict v) { return v == Verdict::fail || v == Verdict::missi
 
 bool higher_is_better(std::string_view metric) {
     if (metric.rfind("accuracy.", 0) == 0) metric.remove_prefix(9);
+    if (metric.rfind("display_", 0) == 0) metric.remove_prefix(8); // the same figures in display space
     return metric.rfind("ssim", 0) == 0 || metric.rfind("psnr", 0) == 0;
 }
 

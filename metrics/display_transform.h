@@ -1,10 +1,13 @@
-// The one display transform of the harness: linear HDR radiance -> display sRGB in [0,1].
+// The display transform of the linear scores: linear HDR radiance -> display sRGB in [0,1].
 //   1. exposure 0 (radiance used as is),
-//   2. the ACES fitted filmic curve (Narkowicz 2015) with the 0.6 pre-exposure folded in: the
-//      same curve and coefficients HDR-FLIP uses (metrics/flip/tone_mappers.h),
+//   2. Narkowicz's ACES fit ("ACES Filmic Tone Mapping Curve", 2016: a luminance-only fit of ACES's
+//      RRT+ODT) with the 0.6 input scale he gives for the original ACES curve folded in: the same
+//      curve and coefficients HDR-FLIP uses (metrics/flip/tone_mappers.h),
 //   3. clamp to [0,1], then the sRGB OETF (IEC 61966-2-1).
 // SSIM on HDR inputs and every PNG written for people go through this, so what a reviewer sees
-// is what SSIM measured.
+// is what SSIM measured. It is the display space (display_space.h) aces_narkowicz, 0 EV, rgba32f,
+// no quantisation (tests/test_display_space.cpp holds them equal); a suite's "display" scores
+// tests in the space a player sees besides.
 #pragma once
 #include <opencv2/core.hpp>
 

@@ -382,6 +382,7 @@ void flicker_section(std::string& o, const std::vector<const json*>& tests) {
 std::string charts_html(const std::vector<const json*>& tests) {
     std::string o;
     cost_sections(o, tests);
+    o += display_section(tests);
     roughness_section(o, tests);
     flicker_section(o, tests);
     return o;

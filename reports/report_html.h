@@ -97,5 +97,9 @@ std::string since_baselines_html(const json& results, const std::vector<const js
 // The charts tab: cost against accuracy, wall time (median and range), error against roughness,
 // flicker against FLIP, each as small multiples. tests[i] is the page's test i (its id test_id(i)).
 std::string charts_html(const std::vector<const json*>& tests);
+// Linear against display scoring (report_display_chart.cpp): "" when no test was scored in a display space.
+std::string display_section(const std::vector<const json*>& tests);
+// Spearman's rank correlation of two series (ties: mean ranks); NaN under 2 values or a constant one.
+double spearman_rho(const std::vector<double>& a, const std::vector<double>& b);
 
 } // namespace iblcheck::report::html

@@ -114,6 +114,8 @@ void check_measurements(const Checker& c, const json& t, const std::string& wher
     if (const json* acc = c.object(t, where, "accuracy")) {
         c.number(*acc, where + ": accuracy", "flip_mean");
         c.string_(*acc, where + ": accuracy", "golden");
+        if (const json* d = c.object(*acc, where + ": accuracy", "display")) // the truth as a player sees it
+            c.number(*d, where + ": accuracy.display", "flip_mean");
     }
     if (const json* ps = c.array(t, where, "per_sphere"))
         for (size_t k = 0; k < ps->size(); ++k) {

@@ -57,8 +57,9 @@ std::vector<std::string> verdict_details(const json& test) {
             if (!any && !str(c, "message").empty()) out.push_back(kind + ": " + str(c, "message"));
             const json& wb = c.value("worst_block", json());
             if (cv == "fail" && is_num(wb, "x") && is_num(wb, "y"))
-                out.push_back(fmt::format("{}: worst 16x16 block at ({},{}){}, mean FLIP {:.4g}", kind, wb["x"].get<int>(),
+                out.push_back(fmt::format("{}: worst 16x16 block at ({},{}){}, mean {} {:.4g}", kind, wb["x"].get<int>(),
                                           wb["y"].get<int>(), str(wb, "sphere").empty() ? "" : " on " + str(wb, "sphere"),
+                                          str(wb, "metric") == "display_flip" ? "LDR-FLIP on the display" : "FLIP",
                                           is_num(wb, "flip") ? wb["flip"].get<double>() : 0.0));
         }
     // Problems no image comparison holds (a render error, NaN pixels, temporal or stability checks).

@@ -16,8 +16,8 @@ namespace iblcheck::flip {
 enum class ToneMapper { reinhard = 0, aces = 1, hable = 2 };
 
 // Coefficients k0..k5 of the rational curve.
-// ACES: Narkowicz 2015, "ACES Filmic Tone Mapping Curve", (x(2.51x + 0.03)) / (x(2.43x + 0.59)
-// + 0.14), with the fitted curve's 0.6 input pre-exposure folded in (x -> 0.6x).
+// ACES: Narkowicz 2016, "ACES Filmic Tone Mapping Curve", (x(2.51x + 0.03)) / (x(2.43x + 0.59)
+// + 0.14), with the 0.6 input scale he gives for the original ACES curve folded in (x -> 0.6x).
 // Hable: John Hable's "Uncharted 2" filmic curve, as the FLIP tool parameterises it.
 inline constexpr float kToneCoefficients[3][6] = {
     {0.0f, 1.0f, 0.0f, 0.0f, 1.0f, 1.0f},                                                // Reinhard
