@@ -1,7 +1,8 @@
 // Issue 29, "Your shader": a team's IBL shading through the shader contract (docs/SHADER_CONTRACT.md).
 // The suite field and its test names, the cache key and provenance hash that follow the file and
 // its includes, the texture-sample count of the cost gate, the errors (exit 2 naming the file),
-// and the example (examples/filament_ibl) failing the ci suite when a bug is put into a copy.
+// and the example (examples/filament_ibl) failing the ci suite when a bug or three more lookups
+// are put into a copy.
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -167,7 +168,7 @@ TEST(Cli, ContractShaderBugFailsTheRun) {
         s["tests"] = tests;
         for (auto& t : s["tests"]) t["shader"] = (dir / folder / "filament_ibl.glsl").string();
         write_file(dir / folder / "ci_example.json", s.dump());
-        return "IBLCHECK_CACHE_DIR=" + dir.string() + " " + bin() + " run -q --suite " +
+        return "IBLCHECK_CACHE_DIR=" + dir.string() + " " + bin() + " run --suite " +
                (dir / folder / "ci_example.json").string();
     };
     std::string text = read_text(kExample), out;
@@ -178,4 +179,16 @@ TEST(Cli, ContractShaderBugFailsTheRun) {
     text.replace(text.find(from), from.size(), "1.0 - f0 * (1.0 / max(dfg.y, 1e-4) - 1.0)");
     EXPECT_EQ(run_command(suite_for("bug", text), out), 1) << out;
     EXPECT_NE(out.find("mobile.roughness_sweep.studio.shader=filament_ibl"), std::string::npos) << out;
+    EXPECT_NE(out.find("baseline: flip.mean"), std::string::npos) << out;
+
+    // The cost gate on a team's shading: the same pixels from four lookups instead of one.
+    text = read_text(kExample);
+    const std::string lookup = "    vec3 radiance = ibl_prefiltered(dir, fil_lod(ibl, r));\n";
+    ASSERT_NE(text.find(lookup), std::string::npos);
+    text.insert(text.find(lookup) + lookup.size(),
+                "    radiance = 0.25 * (radiance + ibl_prefiltered(dir, fil_lod(ibl, r)) + "
+                "ibl_prefiltered(dir, fil_lod(ibl, r)) + ibl_prefiltered(dir, fil_lod(ibl, r)));\n");
+    EXPECT_EQ(run_command(suite_for("cost", text), out), 1) << out;
+    EXPECT_NE(out.find("cost: cost.texture_fetches_per_pixel"), std::string::npos) << out;
+    EXPECT_NE(out.find("+150.0 %"), std::string::npos) << out; // 2 fetches a shading (cube + LUT) -> 5
 }
