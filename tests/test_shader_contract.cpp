@@ -168,8 +168,7 @@ TEST(Cli, ContractShaderBugFailsTheRun) {
         s["tests"] = tests;
         for (auto& t : s["tests"]) t["shader"] = (dir / folder / "filament_ibl.glsl").string();
         write_file(dir / folder / "ci_example.json", s.dump());
-        return "IBLCHECK_CACHE_DIR=" + dir.string() + " " + bin() + " run --suite " +
-               (dir / folder / "ci_example.json").string();
+        return "IBLCHECK_CACHE_DIR=" + dir.string() + " " + bin() + " run --suite " + (dir / folder / "ci_example.json").string();
     };
     std::string text = read_text(kExample), out;
     EXPECT_EQ(run_command(suite_for("same", text), out), 0) << out; // the copy itself passes
