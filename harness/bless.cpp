@@ -156,13 +156,15 @@ void check_label(const std::string& label) {
 
 std::string bless_command(const TestCase& t) {
     const std::string& suite = t.suite_arg.empty() ? t.suite : t.suite_arg;
-    return "iblcheck bless --suite " + shell_quote(suite) + " --filter " + shell_quote(glob_escape(t.name));
+    return "iblcheck bless --suite " + shell_quote(suite) +
+           (t.shader_arg.empty() ? "" : " --shader " + shell_quote(t.shader_arg)) + " --filter " +
+           shell_quote(glob_escape(t.name));
 }
 
 int bless(const BlessOptions& o) {
     if (o.label) check_label(*o.label);
     const std::string label = o.label.value_or("");
-    Suite suite = load_suite(o.suite);
+    Suite suite = load_suite(o.suite, o.shader);
     std::vector<TestCase> tests = select_tests(suite, o.filter, 0, 1);
     if (tests.empty()) throw UsageError("no test in suite " + suite.name + " matches --filter '" + o.filter + "'");
     GoldenStore store(o.goldens);

@@ -14,6 +14,7 @@ namespace iblcheck {
 
 struct BlessOptions {
     std::string suite = "ci";
+    std::string shader; // --shader: a team's shading file for every mobile test (suite.h)
     std::string filter;
     std::optional<std::string> label; // absent: the primary baseline; else baseline@LABEL
     std::filesystem::path goldens;

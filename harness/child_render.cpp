@@ -81,6 +81,7 @@ ChildRender render_in_child(const TestSpec& spec, const std::map<std::string, st
     if (spec.width > 0) args.insert(args.end(), {"--size", fmt::format("{}x{}", spec.width, spec.height)});
     if (!device.empty()) args.insert(args.end(), {"--device", device});
     for (const auto& [k, v] : spec.options.values()) args.insert(args.end(), {"--set", k + "=" + v});
+    if (!spec.shader.empty()) args.insert(args.end(), {"--shader", spec.shader});
     std::vector<std::string> envs = child_environment(env);
     std::vector<char*> argv = c_strings(args), envp = c_strings(envs);
 

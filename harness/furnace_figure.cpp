@@ -24,6 +24,7 @@ TestSpec furnace_spec(const TestCase& tc) {
     s.scene = "furnace";
     s.env = "constant:1";
     s.method = tc.spec.method;
+    s.shader = tc.spec.shader; // a team's shading: its own energy figure
     for (const auto& [k, v] : tc.spec.options.values())
         if (!furnace_drops(k)) s.options.set(k, v);
     s.options.set("cube_size", "16");

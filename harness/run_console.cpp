@@ -20,7 +20,8 @@ void print_test_line(const json& r, int n, size_t total, bool interactive) {
     std::fflush(stdout);
 }
 
-void print_run_summary(const json& R, const RunSummary& s, size_t n_tests, const RunOptions& o, const std::string& suite_arg) {
+void print_run_summary(const json& R, const RunSummary& s, size_t n_tests, const RunOptions& o, const std::string& suite_arg,
+                       const std::string& shader_arg) {
     // The fp16 path mediump tests took (doctor states the same rule): native float16_t, or the
     // emulation on a driver without shaderFloat16 (e.g. a CPU without F16C).
     std::set<std::string> fp16;
@@ -32,7 +33,7 @@ void print_run_summary(const json& R, const RunSummary& s, size_t n_tests, const
     fmt::print("{} tests: {} pass, {} fail, {} improved, {} missing-golden, {} error  ({:.1f} s){}\n", n_tests, s.pass, s.fail,
                s.improved, s.missing, s.error, R["total_s"].get<double>(),
                o.out_dir.empty() ? "" : "  report: " + (o.out_dir / "index.html").string());
-    if (std::string all = rebless_all_line(R["tests"], suite_arg); !all.empty()) fmt::print("{}\n", all);
+    if (std::string all = rebless_all_line(R["tests"], suite_arg, shader_arg); !all.empty()) fmt::print("{}\n", all);
 }
 
 } // namespace iblcheck

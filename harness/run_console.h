@@ -15,6 +15,6 @@ void print_test_line(const nlohmann::json& r, int n, size_t total, bool interact
 
 // The fp16 path mediump tests took, the counts, and the command that approves every failure.
 void print_run_summary(const nlohmann::json& R, const RunSummary& s, size_t n_tests, const RunOptions& o,
-                       const std::string& suite_arg);
+                       const std::string& suite_arg, const std::string& shader_arg = "");
 
 } // namespace iblcheck

@@ -147,7 +147,7 @@ int RunSummary::exit_code() const {
 }
 
 RunSummary run_suite(const RunOptions& o) {
-    Suite suite = load_suite(o.suite);
+    Suite suite = load_suite(o.suite, o.shader);
     std::vector<TestCase> tests = select_tests(suite, o.filter, o.shard_index, o.shard_count);
     if (tests.empty()) throw UsageError("no test in suite " + suite.name + " matches --filter '" + o.filter + "'");
     GoldenStore store(o.goldens);
@@ -167,7 +167,8 @@ RunSummary run_suite(const RunOptions& o) {
         throw InputError(std::string(e.what()) +
                          (o.out_dir.empty() ? "" : "; --out " + o.out_dir.string() + " is left as it was"));
     }
-    print_run_summary(s.results, s, tests.size(), o, tests[0].suite_arg); // -q drops the per-test lines, never this summary
+    print_run_summary(s.results, s, tests.size(), o, tests[0].suite_arg,
+                      tests[0].shader_arg); // -q drops the per-test lines, never this summary
     return s;
 }
 

@@ -20,6 +20,7 @@ namespace iblcheck {
 
 struct RunOptions {
     std::string suite = "ci";
+    std::string shader; // --shader: a team's shading file for every mobile test (suite.h)
     std::string filter; // glob on test names
     int shard_index = 0, shard_count = 1;
     int jobs = 0;                  // 0: the suite's default

@@ -14,6 +14,7 @@
 #include "harness/golden_store.h"
 #include "renderers/option_table.h"
 #include "renderers/renderer.h"
+#include "renderers/vulkan/shader_compiler.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -219,13 +220,25 @@ struct SuiteDefaults {
     std::map<std::string, Bound> bounds;
     std::map<std::string, Band> bands;
     std::optional<DisplaySpace> display;
+    std::string shader; // absolute; the mobile tests' (suite.h)
 };
+
+// A "shader" path, relative to the suite file, as an absolute path to a file that defines ibl_shade.
+std::string shader_path(const Ctx& c, const json& j, const std::string& where, const fs::path& suite_file) {
+    const fs::path file = (fs::absolute(suite_file).parent_path() / c.str(j, where)).lexically_normal();
+    try {
+        vk::check_ibl_shade_file(file);
+    } catch (const InputError& e) {
+        c.fail(where, e.what());
+    }
+    return file.string();
+}
 
 // "defaults": what every test inherits, plus the suite-wide jobs and timing_repeats.
 SuiteDefaults parse_defaults(const Ctx& c, const json& defaults, Suite& suite) {
     c.keys(defaults, "defaults",
            {"env", "size", "jobs", "baseline_tolerances", "reference_band", "stability", "max_cost_growth", "timing_repeats",
-            "display"});
+            "display", "shader"});
     SuiteDefaults d;
     if (defaults.contains("display") && !defaults["display"].is_null())
         d.display = parse_display(c, defaults["display"], "defaults.display");
@@ -233,6 +246,7 @@ SuiteDefaults parse_defaults(const Ctx& c, const json& defaults, Suite& suite) {
     if (defaults.contains("stability"))
         d.stability = parse_stability(c, defaults["stability"], "defaults.stability", d.stability);
     if (defaults.contains("env")) d.env = c.str(defaults["env"], "defaults.env");
+    if (defaults.contains("shader")) d.shader = shader_path(c, defaults["shader"], "defaults.shader", suite.file);
     if (defaults.contains("size")) parse_size(c, defaults["size"], "defaults.size", d.width, d.height);
     if (defaults.contains("jobs")) suite.jobs = c.integer(defaults["jobs"], "defaults.jobs", 1, 1024);
     if (defaults.contains("timing_repeats")) {
@@ -284,7 +298,7 @@ struct TestEntry {
 TestEntry parse_test(const Ctx& c, const json& t, const std::string& w, const Suite& suite, const SuiteDefaults& d) {
     c.keys(t, w,
            {"scene", "method", "env", "size", "options", "variants", "baseline", "reference", "baseline_tolerances",
-            "reference_band", "tags", "temporal", "stability", "max_cost_growth", "tolerance_note", "measure_only", "display"});
+            "reference_band", "tags", "temporal", "stability", "max_cost_growth", "tolerance_note", "measure_only", "display", "shader"});
     if (t.contains("tolerance_note")) c.str(t["tolerance_note"], w + ".tolerance_note");
     if (!t.contains("scene")) c.fail(w + ".scene", "missing required key");
     if (!t.contains("method")) c.fail(w + ".method", "missing required key");
@@ -312,6 +326,10 @@ TestEntry parse_test(const Ctx& c, const json& t, const std::string& w, const Su
     if (!(proto.max_cost_growth >= 0)) c.fail(w + ".max_cost_growth", "must be >= 0");
     proto.spec.scene = c.str(t["scene"], w + ".scene");
     proto.spec.method = c.str(t["method"], w + ".method");
+    if (t.contains("shader"))
+        proto.spec.shader = shader_path(c, t["shader"], w + ".shader", suite.file);
+    else if (proto.spec.method == "mobile")
+        proto.spec.shader = d.shader;
     proto.spec.width = d.width;
     proto.spec.height = d.height;
     if (t.contains("size")) parse_size(c, t["size"], w + ".size", proto.spec.width, proto.spec.height);
@@ -348,6 +366,8 @@ TestEntry parse_test(const Ctx& c, const json& t, const std::string& w, const Su
 // The size goes last and only when given: the names of the suites without one are unchanged.
 std::string variant_name(const TestSpec& spec) {
     std::string v = spec.options.values().empty() ? "" : spec.options.canonical();
+    // A team's shading first: its tests never share a baseline with the built-in's.
+    if (!spec.shader.empty()) v = "shader=" + fs::path(spec.shader).stem().string() + (v.empty() ? "" : "," + v);
     if (spec.width > 0) v += (v.empty() ? "" : ",") + fmt::format("size={}x{}", spec.width, spec.height);
     return v.empty() ? "default" : v;
 }
@@ -415,7 +435,7 @@ void check_judges_its_image(const Ctx& c, const TestCase& tc, const std::string&
 
 } // namespace
 
-Suite load_suite(const std::string& name_or_path) {
+Suite load_suite(const std::string& name_or_path, const std::string& shader) {
     fs::path file = name_or_path;
     if (file.extension() != ".json") file = suite_dir() / (name_or_path + ".json");
     if (!fs::exists(file)) {
@@ -435,14 +455,25 @@ Suite load_suite(const std::string& name_or_path) {
     suite.arg = fs::path(name_or_path).extension() == ".json" ? fs::absolute(file).lexically_normal().string() : name_or_path;
     suite.name = c.str(root["suite"], "suite");
     if (root.contains("description")) suite.description = c.str(root["description"], "description");
-    const SuiteDefaults defaults = parse_defaults(c, root.value("defaults", json::object()), suite);
+    SuiteDefaults defaults = parse_defaults(c, root.value("defaults", json::object()), suite);
+    std::string shader_arg; // --shader: every mobile test's, over the suite's own
+    if (!shader.empty()) {
+        shader_arg = fs::absolute(shader).lexically_normal().string();
+        vk::check_ibl_shade_file(shader_arg); // exit 2 naming the file
+        defaults.shader = shader_arg;
+    }
 
     if (!root["tests"].is_array()) c.fail("tests", "must be an array");
     std::map<std::string, std::string> goldens; // baseline file name -> the test that has it
     std::vector<std::string> where;             // each test's entry, for the check after every name is known
     for (size_t i = 0; i < root["tests"].size(); ++i) {
         const std::string w = "tests[" + std::to_string(i) + "]";
-        expand_test(c, parse_test(c, root["tests"][i], w, suite, defaults), w, goldens, suite);
+        TestEntry entry = parse_test(c, root["tests"][i], w, suite, defaults);
+        if (!shader_arg.empty() && entry.proto.spec.method == "mobile") {
+            entry.proto.spec.shader = shader_arg;
+            entry.proto.shader_arg = shader_arg;
+        }
+        expand_test(c, entry, w, goldens, suite);
         where.resize(suite.tests.size(), w);
     }
     for (size_t k = 0; k < suite.tests.size(); ++k) {

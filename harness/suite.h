@@ -9,9 +9,10 @@
 // {
 //   "suite"*: "ci",  "description": "...",
 //   "defaults": { "env": "studio", "size": "WxH", "jobs": 2, "max_cost_growth": 0.25, "timing_repeats": 1,
+//                 "shader": "path/ibl_shade.glsl",
 //                 "baseline_tolerances": { METRIC: {"min": x, "max": y}, ... },
 //                 "reference_band": { METRIC: {"below": rel, "above": rel, "abs": a}, ... } },
-//   "tests"*: [ { "scene"*: "roughness_sweep", "method"*: "mobile",
+//   "tests"*: [ { "scene"*: "roughness_sweep", "method"*: "mobile", "shader": "path/ibl_shade.glsl",
 //                "env": "studio" | ["studio", "sky_sun"], "size": "WxH",
 //                "options": {k: v}, "variants": [{k: v}, ...],
 //                "baseline": true, "reference": true, "measure_only": false,
@@ -45,6 +46,10 @@
 // that judges nothing would pass any render (a shader writing vec4(0) was "improved" by its cost),
 // so it is an error in the suite unless it says "measure_only": true (its accuracy, cost and
 // timings are recorded for the charts and the history; it fails only if it cannot render).
+// shader: a team's IBL shading file (docs/SHADER_CONTRACT.md), relative to the suite file, that the
+// mobile tests run instead of the built-in split sum (in "defaults": every mobile test's; a test's
+// own wins). Its tests are named with shader=<file stem> first in the variant, so they have their
+// own baselines; the file must exist when the suite is loaded.
 // timing_repeats renders each test that many times in all (1..20): the results then hold the
 // per-frame time's median and range (wall times vary 2-5x on a loaded machine; never gated).
 #pragma once
@@ -94,7 +99,8 @@ struct TestCase {
     std::string name;
     std::string suite;
     std::string suite_arg; // what `--suite` needs to find the suite again: its name, or its path
-    std::string variant;   // "default", or the canonical k=v list of all the test's options then size=WxH if given
+    std::string variant; // "default", or [shader=<stem>,] the canonical k=v list of all the test's options then size=WxH if given
+    std::string shader_arg; // the `--shader FILE` given on the command line (absolute), which its bless command repeats
     TestSpec spec;
     bool baseline = true;      // compare with approved baselines
     bool reference = true;     // measure accuracy against the reference golden (which must exist)
@@ -129,7 +135,8 @@ TestSpec temporal_reference_spec(const TestCase& tc);
 std::filesystem::path suite_dir();
 std::vector<std::string> suite_names();
 // `name_or_path`: a suite name in suite_dir() or a path to a .json file. Throws InputError.
-Suite load_suite(const std::string& name_or_path);
+// `shader`: a team's shading file (`--shader FILE`) every mobile test runs, over the suite's own.
+Suite load_suite(const std::string& name_or_path, const std::string& shader = "");
 // Glob with * and ? (fnmatch semantics on the whole name); several globs separated by '|' match
 // a name when one of them does.
 bool glob_match(const std::string& pattern, const std::string& name);

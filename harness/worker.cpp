@@ -20,7 +20,8 @@ Worker::Worker(const std::string& device) : renderer(context_options(device)), d
 
 const std::vector<cv::Mat>& Worker::sequence(TestSpec spec, int frames) {
     std::string key = spec.method + "|" + spec.scene + "|" + spec.env + "|" + std::to_string(spec.width) + "x" +
-                      std::to_string(spec.height) + "|" + spec.options.canonical() + "|" + std::to_string(frames);
+                      std::to_string(spec.height) + "|" + spec.options.canonical() + "|" + std::to_string(frames) + "|" +
+                      spec.shader;
     auto it = sequences.find(key);
     if (it != sequences.end()) return it->second;
     std::vector<cv::Mat> out;

@@ -17,6 +17,9 @@ struct TestSpec {
     int width = 0, height = 0; // 0: the scene's default size
     OptionMap options;         // material + method variants, one spelling everywhere
     int frame = 0;             // temporal scenes: frame index
+    // mobile: a team's IBL shading file (docs/SHADER_CONTRACT.md) the shading pass calls instead of
+    // the built-in split sum; empty: the built-in. An absolute path (the suite or CLI resolves it).
+    std::string shader;
 };
 
 struct PassTiming {

@@ -4,6 +4,7 @@
 #include <set>
 
 #include "harness/common/errors.h"
+#include "harness/common/hash.h"
 #include "renderers/environments/environment.h"
 #include "renderers/mobile/gpu_session.h"
 #include "renderers/mobile/mobile_renderer.h"
@@ -24,6 +25,28 @@ std::vector<MethodInfo> method_catalog() {
     };
 }
 
+namespace {
+// A team's shading (docs/SHADER_CONTRACT.md) runs in the mobile pipeline and replaces the built-in
+// split sum, so the options that only select parts of that split sum would select nothing: a test
+// that set one would pass for a reason it does not have.
+void validate_contract_spec(const TestSpec& spec) {
+    if (spec.method != "mobile")
+        throw UsageError(spec.shader + ": a team's shading runs in the mobile method only, not in " + spec.method);
+    for (const char* key : {"env_brdf", "dominant_dir", "lagarde_roughness", "normalization", "mix_begin_roughness",
+                            "mix_end_roughness", "mix_largest_weight", "indirect_irradiance"})
+        if (spec.options.has(key))
+            throw UsageError("option '" + std::string(key) + "' selects part of the built-in shading; " + spec.shader +
+                             " does its own (docs/SHADER_CONTRACT.md)");
+}
+
+std::string combined_shader_hash(const std::string& tree, const std::string& ibl_shade) {
+    Fnv1a64 h;
+    h.update(tree);
+    h.update(ibl_shade);
+    return h.hex();
+}
+} // namespace
+
 void validate_spec(const TestSpec& spec) {
     bool known_method = false;
     std::string names;
@@ -32,6 +55,7 @@ void validate_spec(const TestSpec& spec) {
         names += (names.empty() ? "" : ", ") + m.name;
     }
     if (!known_method) throw UsageError("unknown method '" + spec.method + "'; valid: " + names);
+    if (!spec.shader.empty()) validate_contract_spec(spec);
     std::set<std::string> known;
     for (auto& o : option_catalog())
         if (o.read_by(spec.method)) known.insert(o.key);
@@ -91,7 +115,10 @@ RenderResult Renderer::render(const TestSpec& spec) {
     r.provenance["options"] = spec.options.values();
     r.provenance["wall_ms"] = wall_ms;
     if (spec.method != "reference") {
-        r.provenance["shader_tree_hash"] = vk::shader_tree_hash();
+        // A team's shading file is part of the shader source (the report's "since the baselines").
+        r.provenance["shader_tree_hash"] = spec.shader.empty()
+                                               ? vk::shader_tree_hash()
+                                               : combined_shader_hash(vk::shader_tree_hash(), vk::ibl_shade_hash(spec.shader));
         r.provenance["driver"] = driver_json();
     }
     r.coverage = sphere_coverage(build_scene(spec.scene, spec.options), r.image.cols, r.image.rows);

@@ -84,13 +84,14 @@ Trend trend_for(const History& h, const std::string& test) {
     return t;
 }
 
-// The suite argument the bless commands use ("--suite 'ci'"), from a test's bless command.
-std::string suite_arg(const std::vector<const json*>& tests) {
+// The value of `flag` ("--suite ", "--shader ") in the tests' bless commands: the suite argument, and
+// the run's --shader if it had one.
+std::string bless_argument(const std::vector<const json*>& tests, const std::string& flag) {
     for (const json* t : tests) {
         const std::string b = str(*t, "bless_command");
-        size_t p = b.find("--suite ");
+        size_t p = b.find(flag);
         if (p == std::string::npos) continue;
-        p += 8;
+        p += flag.size();
         return shell_word(b, p);
     }
     return "";
@@ -200,7 +201,7 @@ void summary_section(std::string& o, const json& results, const std::vector<cons
                        e(str(results, "command")));
     json arr = json::array();
     for (const json* t : tests) arr.push_back(*t);
-    const std::string all_line = rebless_all_line(arr, suite_arg(tests));
+    const std::string all_line = rebless_all_line(arr, bless_argument(tests, "--suite "), bless_argument(tests, "--shader "));
     const size_t colon = all_line.find(": iblcheck bless");
     if (colon != std::string::npos)
         fmt::format_to(out,

@@ -90,7 +90,7 @@ std::vector<std::string> verdict_details(const json& test) {
     return out;
 }
 
-std::string rebless_all_line(const json& tests, const std::string& suite_arg) {
+std::string rebless_all_line(const json& tests, const std::string& suite_arg, const std::string& shader_arg) {
     std::string filter;
     int n = 0;
     for (const json& t : tests) {
@@ -100,8 +100,9 @@ std::string rebless_all_line(const json& tests, const std::string& suite_arg) {
         ++n;
     }
     if (!n) return "";
-    return fmt::format("approve all {} failure{} (after looking at them): iblcheck bless --suite {} --filter {}", n,
-                       n == 1 ? "" : "s", shell_quote(suite_arg), shell_quote(filter));
+    return fmt::format("approve all {} failure{} (after looking at them): iblcheck bless --suite {}{} --filter {}", n,
+                       n == 1 ? "" : "s", shell_quote(suite_arg),
+                       shader_arg.empty() ? "" : " --shader " + shell_quote(shader_arg), shell_quote(filter));
 }
 
 } // namespace iblcheck::report

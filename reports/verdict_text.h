@@ -23,7 +23,8 @@ std::vector<std::string> verdict_details(const nlohmann::json& test);
 
 // One line that approves every failure (fail and missing-golden) of the run, or "" when there is
 // none: `iblcheck bless --suite 'S' --filter 'a|b|c'` (--filter takes globs separated by '|').
-std::string rebless_all_line(const nlohmann::json& tests, const std::string& suite_arg);
+// `shader_arg`: the run's `--shader FILE`, repeated (empty: none).
+std::string rebless_all_line(const nlohmann::json& tests, const std::string& suite_arg, const std::string& shader_arg = "");
 
 } // namespace iblcheck::report
 

@@ -83,7 +83,7 @@ void register_list_command(CLI::App& app, int& exit_code) {
 
 void register_render_command(CLI::App& app, int& exit_code) {
     auto* cmd = app.add_subcommand("render", "Render a scene with one method");
-    static std::string scene = "sphere", method = "mobile", env = "studio", size, out, json_out, device;
+    static std::string scene = "sphere", method = "mobile", env = "studio", size, out, json_out, device, shader;
     static std::vector<std::string> sets;
     static bool force = false;
     cmd->add_option("--scene", scene, "Scene name (iblcheck list)")->capture_default_str();
@@ -91,6 +91,7 @@ void register_render_command(CLI::App& app, int& exit_code) {
     cmd->add_option("--env", env, "Environment spec (iblcheck list)")->capture_default_str();
     cmd->add_option("--size", size, "Image size WxH (default: the scene's)");
     cmd->add_option("--set", sets, "Option key=value (repeatable)");
+    cmd->add_option("--shader", shader, "mobile: a team's IBL shading file instead of the built-in (docs/SHADER_CONTRACT.md)");
     cmd->add_option("--out", out, "Output EXR (a tone-mapped PNG is written beside it)");
     cmd->add_option("--json", json_out, "Write timings and provenance as JSON to this file ('-' for stdout)");
     cmd->add_option("--device", device, "Vulkan device/driver name substring (default: lavapipe)");
@@ -102,6 +103,7 @@ void register_render_command(CLI::App& app, int& exit_code) {
         spec.env = env;
         parse_size(size, spec.width, spec.height);
         for (auto& s : sets) spec.options.set_from_string(s);
+        if (!shader.empty()) spec.shader = std::filesystem::absolute(shader).lexically_normal().string();
         namespace fs = std::filesystem;
         const fs::path png = out.empty() ? fs::path() : fs::path(out).replace_extension(".png");
         // The environment file is the render's input: never overwritten, not even with --force.

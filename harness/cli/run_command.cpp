@@ -47,6 +47,7 @@ void register_run(CLI::App& app, int& exit_code) {
     auto* r = app.add_subcommand("run", "Run a suite: render, compare with goldens, verdicts, report");
     r->add_option("--suite", run.suite, "Suite name (harness/suites) or a .json path")->capture_default_str();
     r->add_option("--filter", run.filter, "Glob on test names");
+    r->add_option("--shader", run.shader, "A team's IBL shading file for every mobile test (docs/SHADER_CONTRACT.md)");
     r->add_option("--shard", shard, "INDEX/COUNT: run one shard (GTest convention, 0-based)");
     r->add_option("--jobs,-j", run.jobs, "Tests in parallel (default: the suite's)");
     r->add_option("--out", out, "Folder for results.json, images and index.html");
@@ -75,7 +76,7 @@ void register_run(CLI::App& app, int& exit_code) {
         run.goldens = goldens;
         run.command_line = invocation();
         if (list_only) {
-            for (const auto& t : select_tests(load_suite(run.suite), run.filter, run.shard_index, run.shard_count))
+            for (const auto& t : select_tests(load_suite(run.suite, run.shader), run.filter, run.shard_index, run.shard_count))
                 fmt::print("{}\n", t.name);
             exit_code = kExitPass;
             return;
@@ -92,6 +93,7 @@ void register_bless(CLI::App& app, int& exit_code) {
     auto* b = app.add_subcommand("bless", "Re-render and write baseline goldens (the only writer of goldens)");
     b->add_option("--suite", bo.suite, "Suite name or path")->capture_default_str();
     b->add_option("--filter", bo.filter, "Glob on test names (default: every test of the suite)");
+    b->add_option("--shader", bo.shader, "A team's IBL shading file for every mobile test (as `run --shader`)");
     auto* label_opt = b->add_option("--label", label,
                                     "Write an alternate approved baseline <test>@LABEL for a known platform difference "
                                     "(LABEL: A-Z a-z 0-9 . _ -)");

@@ -8,6 +8,7 @@ std::string pipeline_key(const std::string& shaders, const vk::Defines& defines,
     for (const auto& [k, v] : defines) key += ";" + k + "=" + v;
     if (options.emulate_fp16) key += ";pass:fp16-emulation";
     if (options.count_instructions) key += ";count_instructions";
+    if (!options.ibl_shade.empty()) key += ";ibl_shade=" + options.ibl_shade.string();
     return key;
 }
 } // namespace

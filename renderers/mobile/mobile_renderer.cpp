@@ -12,6 +12,8 @@
 #include "renderers/option_table.h"
 #include "renderers/scenes/scene.h"
 #include "renderers/vulkan/fp16_emulation.h"
+#include "renderers/vulkan/shader_compiler.h"
+#include "renderers/vulkan/spirv_samples.h"
 #include "shading_cost.h"
 
 namespace iblcheck {
@@ -62,10 +64,11 @@ std::optional<vk::Fp16Path> fp16_path_of(GpuSession& gpu, const MobileOptions& m
 
 // The shading pass's defines: the storage's, the other selections', and per-sphere AO where the
 // scene has it (scene.glsl).
-vk::Defines shading_defines(const MobileOptions& m, const IblResources& ibl, const Scene& scene) {
+vk::Defines shading_defines(const MobileOptions& m, const IblResources& ibl, const Scene& scene, bool contract) {
     vk::Defines defs = storage_defines(m.ps, ibl);
     defs.merge(glsl_defines(m.variant)); // keeps storage_defines' entries; adds the other selections
     if (scene_uses_ao(scene)) defs["MATERIAL_AO"] = "1";
+    if (contract) defs["IBL_SHADE_CONTRACT"] = "1"; // a team's ibl_shade (ibl_contract.glsl)
     return defs;
 }
 
@@ -106,6 +109,14 @@ double texture_samples_per_hit(const MobileOptions& m) {
     const double env_reads =
         (m.variant.at("normalization") == "directional" ? 2.0 : 1.0) * (m.ps.env_layout == "cube" ? 1.0 : 2.0);
     return env_reads + (m.ps.lut ? 1.0 : 0.0) + (m.ps.irradiance_cube ? 1.0 : 0.0);
+}
+
+// A team's shading (docs/SHADER_CONTRACT.md) does its own lookups: its texture samples per shading
+// are read from its SPIR-V (spirv_samples.h), the module already compiled for the pass.
+double contract_samples_per_hit(const vk::Defines& defines, const vk::CompileOptions& options, bool fragment) {
+    const vk::CompiledShader module =
+        vk::compile_shader(fragment ? "shade_spheres.frag" : "shade_spheres.comp", defines, options);
+    return vk::image_samples_per_call(module.spirv, "ibl_shade(");
 }
 
 // What both shading paths draw with.
@@ -178,7 +189,12 @@ RenderResult render_mobile(GpuSession& gpu, const Environment& env, const TestSp
     const OptionMap& o = spec.options;
     int width = 0, height = 0;
     Scene scene = scene_for(spec, width, height);
-    const MobileOptions m = read_mobile_options(o);
+    MobileOptions m = read_mobile_options(o);
+    const bool contract = !spec.shader.empty();
+    if (contract) {
+        vk::check_ibl_shade_file(spec.shader); // before any GPU work: a missing file is exit 2
+        m.ps.lut = true;                       // the contract always binds the DFG LUT
+    }
     const std::optional<vk::Fp16Path> fp16_path = fp16_path_of(gpu, m);
 
     RenderResult result;
@@ -187,16 +203,17 @@ RenderResult render_mobile(GpuSession& gpu, const Environment& env, const TestSp
     const IblResources& ibl = *ibl_ptr;
 
     ShadingInputs in;
-    in.defines = shading_defines(m, ibl, scene);
+    in.defines = shading_defines(m, ibl, scene, contract);
     in.options.emulate_fp16 = fp16_path == vk::Fp16Path::emulated;
+    if (contract) in.options.ibl_shade = spec.shader;
     vk::Context& ctx = gpu.ctx();
     vk::Buffer scene_buf = upload_scene(ctx, scene);
     in.push = shade_push(o, width, height, m.ps, ibl);
     in.bindings = shading_bindings(ctx, scene_buf, ibl);
     in.sphere_count = uint32_t(scene.spheres.size());
-    in.per_hit = texture_samples_per_hit(m);
-
     const bool fragment = m.variant.at("shading") == "fragment";
+    in.per_hit = contract ? contract_samples_per_hit(in.defines, in.options, fragment) : texture_samples_per_hit(m);
+
     std::optional<double> instructions = fragment ? shade_with_fragments(gpu, in, result) : shade_with_compute(gpu, in, result);
     result.shader_instructions_per_pixel = instructions.value_or(0);
     result.texel_count = ibl.texel_count;
@@ -204,6 +221,10 @@ RenderResult render_mobile(GpuSession& gpu, const Environment& env, const TestSp
     result.provenance = mobile_provenance(m, ibl, cached, instructions, result.texture_fetches_per_pixel);
     if (fp16_path) result.provenance["fp16"] = vk::fp16_path_name(*fp16_path);
     if (fragment) result.provenance["fragment"] = fragment_provenance(in, result.texture_fetches_per_pixel);
+    if (contract)
+        result.provenance["ibl_shade"] = {{"file", std::filesystem::path(spec.shader).filename().string()},
+                                          {"hash", vk::ibl_shade_hash(spec.shader)},
+                                          {"texture_samples_per_shading", in.per_hit}};
     return result;
 }
 

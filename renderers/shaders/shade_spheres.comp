@@ -21,7 +21,16 @@ vec4 shade_ray(vec2 p) {
     SphereGpu s = scene.spheres[id];
     float roughness = specular_aa_roughness(s.roughness_bump.x, n, v, p, vec2(pc.width, pc.height),
                                             pc.specular_aa_variance, pc.specular_aa_threshold);
+#ifdef IBL_SHADE_CONTRACT
+    // The hit point, traced again: the built-in shading needs none, so surface_at keeps its cost.
+    vec3 o, d;
+    float t;
+    camera_ray(p, vec2(pc.width, pc.height), o, d);
+    intersect_scene(o, d, t);
+    return vec4(shade_surface_contract(s, o + d * t, n, v, roughness), 1.0);
+#else
     return vec4(shade_surface(s, n, v, roughness), 1.0);
+#endif
 }
 
 void main() {

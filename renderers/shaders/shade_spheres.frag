@@ -34,6 +34,9 @@ void main() {
     // Coverage: the samples whose rays hit the sphere. Where the centre misses, shading moves to
     // the first covered sample, as centroid interpolation does.
     uint mask = 0u;
+#ifdef IBL_SHADE_CONTRACT
+    vec2 shading_point = gl_FragCoord.xy;  // where the shading's ray starts (the contract's position)
+#endif
     for (int k = 0; k < 4; ++k) {
         vec3 nk, vk;
         float tk;
@@ -42,6 +45,9 @@ void main() {
                 n = nk;
                 v = vk;
                 t = tk;
+#ifdef IBL_SHADE_CONTRACT
+                shading_point = corner + SAMPLES_4X[k];
+#endif
             }
             mask |= 1u << k;
         }
@@ -50,7 +56,13 @@ void main() {
 
     float roughness = specular_aa_roughness_from_derivatives(s.roughness_bump.x, n, dn_dx, dn_dy, dr_dx, dr_dy,
                                                              pc.specular_aa_variance, pc.specular_aa_threshold);
+#ifdef IBL_SHADE_CONTRACT
+    vec3 o, d;
+    camera_ray_of(cam, shading_point, size, o, d);
+    color = vec4(shade_surface_contract(s, o + d * t, n, v, roughness), 1.0);
+#else
     color = vec4(shade_surface(s, n, v, roughness), 1.0);
+#endif
     gl_SampleMask[0] = int(mask);
     gl_FragDepth = t / (t + 1.0);  // monotonic in t, in [0, 1): the nearest hit along the ray wins
 }

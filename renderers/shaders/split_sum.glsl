@@ -103,4 +103,8 @@ vec3 shade_surface(SphereGpu s, vec3 n, vec3 v, float roughness) {
     hvec3 diffuse = hfloat(1.0 - metallic) * hvec3(base) * hvec3(diffuse_light);
     return vec3(diffuse + specular);
 }
+
+#ifdef IBL_SHADE_CONTRACT
+#include "ibl_contract.glsl"  // a team's shading instead (docs/SHADER_CONTRACT.md)
+#endif
 #endif

@@ -33,7 +33,9 @@ std::string read_text(const fs::path& p) {
     return ss.str();
 }
 
-fs::path resolve_include(const std::string& name, const fs::path& includer_dir) {
+// `ibl_shade`: the team's file that kIblShadeInclude names (CompileOptions::ibl_shade), if any.
+fs::path resolve_include(const std::string& name, const fs::path& includer_dir, const fs::path& ibl_shade) {
+    if (name == kIblShadeInclude && !ibl_shade.empty()) return fs::weakly_canonical(ibl_shade);
     fs::path a = includer_dir / name;
     if (fs::exists(a)) return fs::weakly_canonical(a);
     fs::path b = shader_dir() / name;
@@ -43,7 +45,7 @@ fs::path resolve_include(const std::string& name, const fs::path& includer_dir) 
 
 // Hashes the file and, recursively, every file it includes (in order), so the cache key changes
 // whenever any of them does. Missing includes are left for glslang to report with file:line.
-void hash_sources(const fs::path& file, Fnv1a64& h, std::set<fs::path>& seen) {
+void hash_sources(const fs::path& file, Fnv1a64& h, std::set<fs::path>& seen, const fs::path& ibl_shade) {
     if (!seen.insert(file).second) return;
     std::string text = read_text(file);
     h.update(file.filename().string());
@@ -54,17 +56,18 @@ void hash_sources(const fs::path& file, Fnv1a64& h, std::set<fs::path>& seen) {
     while (std::getline(in, line)) {
         std::smatch m;
         if (std::regex_search(line, m, inc)) {
-            fs::path p = resolve_include(m[1].str(), file.parent_path());
-            if (!p.empty()) hash_sources(p, h, seen);
+            fs::path p = resolve_include(m[1].str(), file.parent_path(), ibl_shade);
+            if (!p.empty()) hash_sources(p, h, seen, ibl_shade);
         }
     }
 }
 
 class FileIncluder : public glslang::TShader::Includer {
   public:
+    explicit FileIncluder(fs::path ibl_shade) : ibl_shade_(std::move(ibl_shade)) {}
     IncludeResult* includeLocal(const char* header, const char* includer, size_t) override {
         fs::path dir = fs::path(includer).parent_path();
-        fs::path p = resolve_include(header, dir.empty() ? shader_dir() : dir);
+        fs::path p = resolve_include(header, dir.empty() ? shader_dir() : dir, ibl_shade_);
         if (p.empty()) return nullptr;
         auto* text = new std::string(read_text(p));
         return new IncludeResult(p.string(), text->data(), text->size(), text);
@@ -77,6 +80,9 @@ class FileIncluder : public glslang::TShader::Includer {
         delete static_cast<std::string*>(r->userData);
         delete r;
     }
+
+  private:
+    fs::path ibl_shade_;
 };
 
 // glslang reports "ERROR: /path/file.comp:12: 'x' : undeclared identifier"; reformat each to
@@ -136,6 +142,26 @@ std::string shader_tree_hash() {
     return h.hex();
 }
 
+void check_ibl_shade_file(const fs::path& file) {
+    std::error_code ec;
+    if (!fs::exists(file, ec))
+        throw InputError(file.string() + ": shader file not found (a team's IBL shading, docs/SHADER_CONTRACT.md)");
+    if (!fs::is_regular_file(file, ec)) throw InputError(file.string() + ": not a regular file (a GLSL shading file)");
+    // The one function the contract asks for; without it glslang would name the harness's file.
+    static const std::regex fn(R"re(\bvec3\s+ibl_shade\s*\()re");
+    if (!std::regex_search(read_text(file), fn))
+        throw InputError(file.string() + ": no function `vec3 ibl_shade(IblSurface s, IblInputs ibl)` (docs/SHADER_CONTRACT.md)");
+}
+
+std::string ibl_shade_hash(const fs::path& file) {
+    check_ibl_shade_file(file);
+    Fnv1a64 h;
+    std::set<fs::path> seen;
+    const fs::path canonical = fs::weakly_canonical(file);
+    hash_sources(canonical, h, seen, canonical);
+    return h.hex();
+}
+
 namespace {
 struct Stage {
     EShLanguage language;
@@ -179,7 +205,7 @@ std::string cache_key(const fs::path& path, Stage stage, const Defines& defines,
     Fnv1a64 h;
     h.update(std::string(stage.key) + ";glslang-vulkan1.2;");
     std::set<fs::path> seen;
-    hash_sources(path, h, seen);
+    hash_sources(path, h, seen, options.ibl_shade);
     for (const auto& [k, v] : defines) {
         std::string entry = k;
         h.update(entry.append("=").append(v).append(";"));
@@ -244,7 +270,8 @@ void write_cached(const fs::path& file, const std::vector<uint32_t>& spirv) {
 
 // GLSL (version 460, Vulkan rules) to SPIR-V 1.5 for Vulkan 1.2, unoptimised. glslang's process
 // state is global: one compile at a time.
-std::vector<uint32_t> glslang_compile(const fs::path& path, EShLanguage language, const std::string& preamble) {
+std::vector<uint32_t> glslang_compile(const fs::path& path, EShLanguage language, const std::string& preamble,
+                                      const fs::path& ibl_shade) {
     std::string source = read_text(path);
     std::lock_guard lock(compile_mutex());
     static GlslangProcess process;
@@ -258,7 +285,7 @@ std::vector<uint32_t> glslang_compile(const fs::path& path, EShLanguage language
     shader.setEnvInput(glslang::EShSourceGlsl, language, glslang::EShClientVulkan, 100);
     shader.setEnvClient(glslang::EShClientVulkan, glslang::EShTargetVulkan_1_2);
     shader.setEnvTarget(glslang::EShTargetSpv, glslang::EShTargetSpv_1_5);
-    FileIncluder includer;
+    FileIncluder includer(ibl_shade);
     auto msgs = static_cast<EShMessages>(EShMsgSpvRules | EShMsgVulkanRules);
     if (!shader.parse(GetDefaultResources(), 460, false, msgs, includer))
         throw ShaderCompileError(format_log(shader.getInfoLog()));
@@ -290,6 +317,7 @@ void apply_passes(std::vector<uint32_t>& spirv, const CompileOptions& options, c
 
 CompiledShader compile_stage_file(const fs::path& path_in, Stage stage, const Defines& defines, const CompileOptions& options) {
     const fs::path path = fs::weakly_canonical(path_in);
+    if (!options.ibl_shade.empty()) check_ibl_shade_file(options.ibl_shade); // before its text is hashed
     CompiledShader out;
     out.source_hash = cache_key(path, stage, defines, options);
     out.counts_instructions = options.count_instructions;
@@ -299,7 +327,7 @@ CompiledShader compile_stage_file(const fs::path& path_in, Stage stage, const De
         out.from_cache = true;
         return out;
     }
-    out.spirv = glslang_compile(path, stage.language, preamble_of(defines));
+    out.spirv = glslang_compile(path, stage.language, preamble_of(defines), options.ibl_shade);
     apply_passes(out.spirv, options, path);
     write_cached(cached, out.spirv);
     return out;

@@ -26,6 +26,9 @@ struct CompileOptions {
     // Instrument the SPIR-V to count the instructions each invocation executes (spirv_cost.h).
     // Applied last, so it counts exactly what the pipeline runs.
     bool count_instructions = false;
+    // A team's IBL shading (docs/SHADER_CONTRACT.md): the file `#include "ibl_shade_user.glsl"`
+    // resolves to (empty: the built-in shading). Its text and its includes are in the cache key.
+    std::filesystem::path ibl_shade;
 };
 
 struct CompiledShader {
@@ -54,6 +57,14 @@ CompiledShader compile_shader_file(const std::filesystem::path& path, const Defi
 
 // A hash over every .glsl/.comp file in shader_dir(): the "shader source hash" of provenance.
 std::string shader_tree_hash();
+
+// The include name a pass uses for the team's shading file (CompileOptions::ibl_shade).
+inline constexpr const char* kIblShadeInclude = "ibl_shade_user.glsl";
+// A team's shading file checked before any compile: it exists, is a regular file and defines
+// `vec3 ibl_shade(` (docs/SHADER_CONTRACT.md). Throws InputError naming the file (exit 2).
+void check_ibl_shade_file(const std::filesystem::path& file);
+// A hash of a team's shading file and, recursively, every file it includes: its provenance.
+std::string ibl_shade_hash(const std::filesystem::path& file);
 
 // Where cached SPIR-V goes: $IBLCHECK_CACHE_DIR/spirv or <source root>/.cache/spirv.
 std::filesystem::path spirv_cache_dir();
