@@ -51,8 +51,8 @@ json approved_accuracy(const GoldenStore& store, const TestCase& tc, const Rende
                          ": no reference golden, and the test asks for one (\"reference\": true); create it with: " +
                          truth_command(tc.spec, store));
     // An edited environment file: the truth was made from other pixels, so the accuracy would be wrong.
-    const std::string truth_hash = ref->provenance.value("env", json::object()).value("content_hash", "");
-    const std::string now = rr.provenance.value("env_hash", "");
+    const std::string truth_hash = truth_env_hash(ref->provenance);
+    const std::string now = rr.provenance.contains("env_hash") ? rr.provenance["env_hash"].get<std::string>() : "";
     if (is_environment_file(tc.spec.env) && !truth_hash.empty() && truth_hash != now)
         throw InputError(fmt::format("{}: its content changed since {} was made from it (content hash {} there, {} now); "
                                      "re-render the truth with: {}",

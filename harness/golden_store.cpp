@@ -98,6 +98,13 @@ std::string truth_command(const TestSpec& spec, const GoldenStore& store) {
     return c;
 }
 
+std::string truth_env_hash(const json& sidecar) {
+    const json env = sidecar.is_object() ? sidecar.value("env", json()) : json();
+    return env.is_object() && env.contains("content_hash") && env["content_hash"].is_string()
+               ? env["content_hash"].get<std::string>()
+               : "";
+}
+
 GoldenStore::GoldenStore(fs::path root) {
     if (root.empty()) {
         if (const char* e = std::getenv("IBLCHECK_GOLDEN_DIR"); e && *e)

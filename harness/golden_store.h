@@ -70,6 +70,8 @@ std::string reference_key(const TestSpec& spec);
 // test whose truth is missing prints (iblcheck truth ... --env FILE [--env-name N] [--size WxH]
 // [--set k=v] [--goldens ROOT]).
 std::string truth_command(const TestSpec& spec, const GoldenStore& store);
+// The environment content hash a truth sidecar records (env.content_hash); "" when it has none.
+std::string truth_env_hash(const nlohmann::json& sidecar);
 // File-system-safe form of a test name.
 std::string safe_file_name(const std::string& name);
 

@@ -106,7 +106,7 @@ void record_images(TestRun& t, const RenderResult& rr) {
 // edited HDRI used to be judged against the old truth and baselines without a word.
 void check_environment_unchanged(const TestCase& tc, const RenderResult& rr, const std::string& recorded, const fs::path& golden,
                                  const std::string& fix) {
-    const std::string now = rr.provenance.value("env_hash", "");
+    const std::string now = rr.provenance.contains("env_hash") ? rr.provenance["env_hash"].get<std::string>() : "";
     if (!is_environment_file(tc.spec.env) || recorded.empty() || now.empty() || recorded == now) return;
     throw InputError(fmt::format("{}: its content changed since {} was made from it (content hash {} there, {} now); {}",
                                  tc.spec.env, golden.string(), recorded, now, fix));
@@ -124,7 +124,10 @@ BaselineOutcome check_baselines(TestRun& t, const RenderResult& rr) {
     // The truth was made from the old file too: it is re-rendered first (bless measures the accuracy against it).
     const std::string rebless = "re-bless after looking at it: " + bless_command(t.tc, t.store);
     check_environment_unchanged(
-        t.tc, rr, base.golden.provenance.value("env_hash", ""), base.golden.image_path,
+        t.tc, rr,
+        (base.golden.provenance.value("env_hash", json()).is_string() ? base.golden.provenance["env_hash"].get<std::string>()
+                                                                      : ""),
+        base.golden.image_path,
         t.tc.reference ? "re-render its truth: " + truth_command(t.tc.spec, t.store) + " --force; " + rebless : rebless);
     t.r["comparisons"].back()["approved"] = baseline_facts(base.golden.provenance);
     t.add(base.comparison.verdict, base.comparison.message.empty() ? "" : "baseline: " + base.comparison.message);
@@ -163,7 +166,7 @@ cv::Mat check_reference(TestRun& t, const RenderResult& rr, const BaselineOutcom
         throw InputError(t.store.reference_path(t.tc.spec).string() +
                          ": no reference golden, and the test asks for one (\"reference\": true); create it with: " +
                          truth_command(t.tc.spec, t.store) + " (or set \"reference\": false in the suite)");
-    check_environment_unchanged(t.tc, rr, ref->provenance.value("env", json::object()).value("content_hash", ""), ref->image_path,
+    check_environment_unchanged(t.tc, rr, truth_env_hash(ref->provenance), ref->image_path,
                                 "re-render the truth with: " + truth_command(t.tc.spec, t.store));
     check_approved_accuracy(t, base);
     Comparison c = judge_against_truth(t.tc, rr, *ref, t.store, approved_accuracy(base), t.art, t.flip_threads, t.r);
