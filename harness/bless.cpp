@@ -15,11 +15,13 @@
 #include "golden_store.h"
 #include "harness/common/errors.h"
 #include "harness/common/input_file.h"
+#include "harness/common/program.h"
 #include "harness/common/shell_quote.h"
 #include "image_compare.h"
 #include "metrics/image_io.h"
 #include "provenance.h"
 #include "verdict.h"
+#include "renderers/environments/environment.h"
 #include "worker.h"
 
 namespace fs = std::filesystem;
@@ -41,12 +43,21 @@ json read_sidecar(const fs::path& exr) {
 
 // The accuracy against the reference golden that the reference band is built on. A test that asks
 // for the truth must have it: a golden blessed without its accuracy used to drop the check silently.
-json approved_accuracy(const GoldenStore& store, const TestCase& tc, const cv::Mat& image) {
+json approved_accuracy(const GoldenStore& store, const TestCase& tc, const RenderResult& rr) {
+    const cv::Mat& image = rr.image;
     if (!tc.reference) return json::object();
     auto ref = store.reference(tc.spec);
     if (!ref)
         throw InputError(store.reference_path(tc.spec).string() +
-                         ": no reference golden, and the test asks for one (\"reference\": true)");
+                         ": no reference golden, and the test asks for one (\"reference\": true); create it with: " +
+                         truth_command(tc.spec, store));
+    // An edited environment file: the truth was made from other pixels, so the accuracy would be wrong.
+    const std::string truth_hash = truth_env_hash(ref->provenance);
+    const std::string now = rr.provenance.contains("env_hash") ? rr.provenance["env_hash"].get<std::string>() : "";
+    if (is_environment_file(tc.spec.env) && !truth_hash.empty() && truth_hash != now)
+        throw InputError(fmt::format("{}: its content changed since {} was made from it (content hash {} there, {} now); "
+                                     "re-render the truth with: {}",
+                                     tc.spec.env, ref->image_path.string(), truth_hash, now, truth_command(tc.spec, store)));
     if (ref->image.size() != image.size())
         throw InputError(fmt::format("{}: {}x{}, but the render is {}x{}", ref->image_path.string(), ref->image.cols,
                                      ref->image.rows, image.cols, image.rows));
@@ -130,10 +141,10 @@ json sidecar(const TestCase& tc, const RenderResult& rr, const GoldenStore& stor
     prov["variant"] = tc.variant;
     prov["size"] = {rr.image.cols, rr.image.rows};
     prov["label"] = label.value_or("");
-    prov["accuracy"] = approved_accuracy(store, tc, rr.image);
+    prov["accuracy"] = approved_accuracy(store, tc, rr);
     prov["cost"] = render_cost(rr);
     for (auto& [k, v] : common.items()) prov[k] = v;
-    prov["command"] = bless_command(tc) + (label ? " --label " + shell_quote(*label) : "");
+    prov["command"] = bless_command(tc, "iblcheck") + (label ? " --label " + shell_quote(*label) : "");
     return prov;
 }
 
@@ -154,11 +165,15 @@ void check_label(const std::string& label) {
         throw UsageError("--label '" + label + "': a label is one or more of A-Z a-z 0-9 . _ - (it names a file)");
 }
 
-std::string bless_command(const TestCase& t) {
+std::string bless_command(const TestCase& t, const std::string& program) {
     const std::string& suite = t.suite_arg.empty() ? t.suite : t.suite_arg;
-    return "iblcheck bless --suite " + shell_quote(suite) +
+    return program + " bless --suite " + shell_quote(suite) +
            (t.shader_arg.empty() ? "" : " --shader " + shell_quote(t.shader_arg)) + " --filter " +
            shell_quote(glob_escape(t.name));
+}
+std::string bless_command(const TestCase& t, const GoldenStore& store) {
+    const std::string c = bless_command(t);
+    return store.root() == GoldenStore().root() ? c : c + " --goldens " + shell_arg(store.root().string());
 }
 
 int bless(const BlessOptions& o) {

@@ -8,6 +8,7 @@
 #include <optional>
 #include <string>
 
+#include "harness/common/program.h"
 #include "suite.h"
 
 namespace iblcheck {
@@ -29,7 +30,13 @@ void check_label(const std::string& label);
 // is written for a failed render).
 int bless(const BlessOptions& options);
 
-// The bless command that approves a test (shown on failure).
-std::string bless_command(const TestCase& t);
+// The bless command that approves a test (shown on failure): the running binary as a person types
+// it (program_name(): build/iblcheck after scripts/run.sh), so that it runs as printed. A sidecar
+// records it with the portable "iblcheck" (no machine's paths in goldens).
+std::string bless_command(const TestCase& t, const std::string& program = program_name());
+class GoldenStore;
+// The same, with --goldens ROOT when `store` is not the default one (a run with --goldens printed a
+// bless command that wrote into goldens/).
+std::string bless_command(const TestCase& t, const GoldenStore& store);
 
 } // namespace iblcheck

@@ -56,7 +56,7 @@ BaselineOutcome missing_baseline(const TestCase& tc, const GoldenStore& store) {
     out.comparison.kind = "baseline";
     out.comparison.verdict = Verdict::missing_golden;
     out.comparison.message =
-        "no baseline golden at " + store.baseline_path(tc.name).string() + "; create it with: " + bless_command(tc);
+        "no baseline golden at " + store.baseline_path(tc.name).string() + "; create it with: " + bless_command(tc, store);
     return out;
 }
 

@@ -11,8 +11,11 @@
 
 #include "harness/common/errors.h"
 #include "harness/common/input_file.h"
+#include "harness/common/program.h"
+#include "harness/common/shell_quote.h"
 #include "metrics/image_formats.h"
 #include "metrics/image_io.h"
+#include "renderers/environments/environment.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -70,15 +73,36 @@ std::string safe_file_name(const std::string& name) {
     return s;
 }
 
+namespace {
+// The options that change the true image (and so its key).
+const std::set<std::string> kMaterialOptions = {"roughness", "metallic", "base_color", "env_rotation", "ao"};
+} // namespace
+
 std::string reference_key(const TestSpec& spec) {
-    std::string key = spec.scene + "__" + safe_file_name(spec.env);
-    static const std::set<std::string> material = {"roughness", "metallic", "base_color", "env_rotation", "ao"};
+    std::string key = spec.scene + "__" + safe_file_name(environment_label(spec.env, spec.env_name));
     std::string extra;
     for (auto& [k, v] : spec.options.values())
-        if (material.count(k)) extra += (extra.empty() ? "" : ",") + k + "=" + v;
+        if (kMaterialOptions.count(k)) extra += (extra.empty() ? "" : ",") + k + "=" + v;
     if (!extra.empty()) key += "__" + safe_file_name(extra);
     if (spec.width > 0) key += "__" + std::to_string(spec.width) + "x" + std::to_string(spec.height);
     return key;
+}
+
+std::string truth_command(const TestSpec& spec, const GoldenStore& store) {
+    std::string c = program_name() + " truth --scene " + shell_arg(spec.scene) + " --env " + shell_arg(spec.env);
+    if (!spec.env_name.empty()) c += " --env-name " + shell_arg(spec.env_name);
+    if (spec.width > 0) c += " --size " + std::to_string(spec.width) + "x" + std::to_string(spec.height);
+    for (auto& [k, v] : spec.options.values())
+        if (kMaterialOptions.count(k)) c += " --set " + shell_arg(k + "=" + v);
+    if (store.root() != GoldenStore().root()) c += " --goldens " + shell_arg(store.root().string());
+    return c;
+}
+
+std::string truth_env_hash(const json& sidecar) {
+    const json env = sidecar.is_object() ? sidecar.value("env", json()) : json();
+    return env.is_object() && env.contains("content_hash") && env["content_hash"].is_string()
+               ? env["content_hash"].get<std::string>()
+               : "";
 }
 
 GoldenStore::GoldenStore(fs::path root) {

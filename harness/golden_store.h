@@ -61,10 +61,17 @@ class GoldenStore {
     std::filesystem::path root_;
 };
 
-// <scene>__<env>: ':' and '/' in the env spec become '-'; material options of single-sphere scenes
+// <scene>__<env>: the environment's stable name (environment_label: a built-in spec with ':' as '-', a
+// file's suite-given name or its file name, never its folder), material options of single-sphere scenes
 // (roughness, metallic, base_color), a non-default size and env_rotation are appended, since they
 // change the true image.
 std::string reference_key(const TestSpec& spec);
+// The command that renders the truth `spec` asks for into `store` under reference_key(spec): what a
+// test whose truth is missing prints (iblcheck truth ... --env FILE [--env-name N] [--size WxH]
+// [--set k=v] [--goldens ROOT]).
+std::string truth_command(const TestSpec& spec, const GoldenStore& store);
+// The environment content hash a truth sidecar records (env.content_hash); "" when it has none.
+std::string truth_env_hash(const nlohmann::json& sidecar);
 // File-system-safe form of a test name.
 std::string safe_file_name(const std::string& name);
 

@@ -7,11 +7,13 @@
 #include <cmath>
 
 #include <fstream>
+#include <regex>
 #include <set>
 
 #include "harness/common/errors.h"
 #include "harness/common/json_check.h"
 #include "harness/golden_store.h"
+#include "renderers/environments/environment.h"
 #include "renderers/option_table.h"
 #include "renderers/renderer.h"
 #include "renderers/vulkan/shader_compiler.h"
@@ -161,6 +163,32 @@ void parse_size(const Ctx& c, const json& j, const std::string& where, int& w, i
         c.fail(where, "'" + s + "' is not WxH");
 }
 
+// One environment of a suite: a spec (built-in, or a file path) or {"file": PATH, "name": NAME}. A
+// relative file path is the suite file's neighbour (the suite and its HDRIs move together); the test
+// names and golden keys use its stable name (environment_label), never the path.
+struct EnvEntry {
+    std::string spec, name;
+};
+EnvEntry parse_env(const Ctx& c, const json& j, const std::string& where, const fs::path& suite_file) {
+    EnvEntry e;
+    if (j.is_object()) {
+        c.keys(j, where, {"file", "name"});
+        if (!j.contains("file")) c.fail(where + ".file", "missing required key");
+        e.spec = c.str(j["file"], where + ".file");
+        if (j.contains("name")) e.name = c.str(j["name"], where + ".name");
+        if (!is_environment_file(e.spec)) c.fail(where + ".file", "'" + e.spec + "' is a built-in environment, not a file");
+    } else {
+        e.spec = c.str(j, where);
+    }
+    if (is_environment_file(e.spec) && fs::path(e.spec).is_relative())
+        e.spec = (fs::absolute(suite_file).parent_path() / e.spec).lexically_normal().string();
+    // The name is a file name and a glob-free test-name part; a built-in's name would take its goldens.
+    static const std::regex ok("[A-Za-z0-9._-]+");
+    if (j.is_object() && j.contains("name") && (!std::regex_match(e.name, ok) || !is_environment_file(e.name)))
+        c.fail(where + ".name", "'" + e.name + "' must be one or more of A-Z a-z 0-9 . _ - and not a built-in environment");
+    return e;
+}
+
 } // namespace
 
 TestSpec without_specular_aa(TestSpec spec) {
@@ -215,7 +243,7 @@ namespace {
 struct SuiteDefaults {
     double max_cost_growth = 0.25;
     StabilitySpec stability;
-    std::string env = "studio";
+    EnvEntry env{"studio", ""};
     int width = 0, height = 0;
     std::map<std::string, Bound> bounds;
     std::map<std::string, Band> bands;
@@ -245,7 +273,7 @@ SuiteDefaults parse_defaults(const Ctx& c, const json& defaults, Suite& suite) {
     if (defaults.contains("max_cost_growth")) d.max_cost_growth = c.num(defaults["max_cost_growth"], "defaults.max_cost_growth");
     if (defaults.contains("stability"))
         d.stability = parse_stability(c, defaults["stability"], "defaults.stability", d.stability);
-    if (defaults.contains("env")) d.env = c.str(defaults["env"], "defaults.env");
+    if (defaults.contains("env")) d.env = parse_env(c, defaults["env"], "defaults.env", suite.file);
     if (defaults.contains("shader")) d.shader = shader_path(c, defaults["shader"], "defaults.shader", suite.file);
     if (defaults.contains("size")) parse_size(c, defaults["size"], "defaults.size", d.width, d.height);
     if (defaults.contains("jobs")) suite.jobs = c.integer(defaults["jobs"], "defaults.jobs", 1, 1024);
@@ -290,7 +318,7 @@ TemporalSpec parse_temporal(const Ctx& c, const json& tj, const std::string& tw)
 // and its variants (each test case is one environment × one variant).
 struct TestEntry {
     TestCase proto;
-    std::vector<std::string> envs;
+    std::vector<EnvEntry> envs;
     OptionMap base_opts;
     std::vector<OptionMap> variants;
 };
@@ -307,9 +335,9 @@ TestEntry parse_test(const Ctx& c, const json& t, const std::string& w, const Su
         entry.envs.push_back(d.env);
     else if (t["env"].is_array())
         for (size_t k = 0; k < t["env"].size(); ++k)
-            entry.envs.push_back(c.str(t["env"][k], w + ".env[" + std::to_string(k) + "]"));
+            entry.envs.push_back(parse_env(c, t["env"][k], w + ".env[" + std::to_string(k) + "]", suite.file));
     else
-        entry.envs.push_back(c.str(t["env"], w + ".env"));
+        entry.envs.push_back(parse_env(c, t["env"], w + ".env", suite.file));
     if (t.contains("options")) entry.base_opts = c.options(t["options"], w + ".options");
     if (t.contains("variants")) {
         if (!t["variants"].is_array()) c.fail(w + ".variants", "must be an array of option objects");
@@ -380,11 +408,12 @@ void expand_test(const Ctx& c, const TestEntry& entry, const std::string& w, std
     for (const auto& env : entry.envs)
         for (const auto& variant : entry.variants) {
             TestCase tc = entry.proto;
-            tc.spec.env = env;
+            tc.spec.env = env.spec;
+            tc.spec.env_name = env.name;
             tc.spec.options = entry.base_opts;
             for (auto& [k, v] : variant.values()) tc.spec.options.set(k, v);
             tc.variant = variant_name(tc.spec);
-            tc.name = tc.spec.method + "." + tc.spec.scene + "." + env + "." + tc.variant;
+            tc.name = tc.spec.method + "." + tc.spec.scene + "." + environment_label(env.spec, env.name) + "." + tc.variant;
             if (tc.display) tc.name += ".display=" + display_label(*tc.display);
             try {
                 validate_spec(tc.spec);

@@ -1,7 +1,8 @@
 // Suites are data: harness/suites/<name>.json, one schema, validated with errors that name the
 // file, the key and the problem. A suite expands into TestCases: each entry may list several
 // environments and variants, and every combination is one test named
-//   <method>.<scene>.<env>.<options>      (options: "k=v,k=v" of all the test's options, then size=WxH when the
+//   <method>.<scene>.<env>.<options>      (env: the environment's stable name, environment_label: a
+//                                          built-in spec, or a file's "name", else its file name; options: "k=v,k=v" of all the test's options, then size=WxH when the
 //                                          test gives a size; "default" when neither)
 //   <method>.<scene>.<env>.<options>.display=<tonemap>_<ev>ev_<quantize>_<target>   (a test with a "display")
 //
@@ -14,6 +15,9 @@
 //                 "reference_band": { METRIC: {"below": rel, "above": rel, "abs": a}, ... } },
 //   "tests"*: [ { "scene"*: "roughness_sweep", "method"*: "mobile", "shader": "path/ibl_shade.glsl",
 //                "env": "studio" | ["studio", "sky_sun"], "size": "WxH",
+//                       (an environment file: "hdri/city.exr" or {"file": "hdri/city.exr", "name": "city"}; a
+//                        relative path is from the suite file's folder; its content hash is in every golden's
+//                        sidecar, and a changed file is an error naming it)
 //                "options": {k: v}, "variants": [{k: v}, ...],
 //                "baseline": true, "reference": true, "measure_only": false,
 //                "display": {"tonemap"*: "aces_narkowicz" | "pbr_neutral", "exposure": 0, "quantize": "srgb8" | "none",

@@ -54,8 +54,8 @@ TemporalOutcome run_temporal(const TestCase& tc, Worker& w, const GoldenStore& s
          {"reference", {{"method", ref.method}, {"options", ref.options.canonical()}}}};
     // The truth: the same scene's quadrature truth, frame by frame (no method-specific options).
     TestSpec truth_spec;
-    truth_spec.scene = tc.spec.scene, truth_spec.env = tc.spec.env, truth_spec.width = tc.spec.width,
-    truth_spec.height = tc.spec.height;
+    truth_spec.scene = tc.spec.scene, truth_spec.env = tc.spec.env, truth_spec.env_name = tc.spec.env_name,
+    truth_spec.width = tc.spec.width, truth_spec.height = tc.spec.height;
     for (const char* k : {"roughness", "metallic", "base_color", "env_rotation"})
         if (tc.spec.options.has(k)) truth_spec.options.set(k, tc.spec.options.get_string(k, ""));
     std::vector<cv::Mat> truth_linear;

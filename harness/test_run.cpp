@@ -12,6 +12,7 @@
 #include "harness/common/errors.h"
 #include "metrics/image_io.h"
 #include "provenance.h"
+#include "renderers/environments/environment.h"
 #include "stability.h"
 #include "temporal_check.h"
 #include "verdict.h"
@@ -24,17 +25,17 @@ namespace iblcheck {
 namespace {
 
 // What the test is, before anything is rendered.
-json test_header(const TestCase& tc) {
+json test_header(const TestCase& tc, const GoldenStore& store) {
     return {{"name", tc.name},
             {"suite", tc.suite},
             {"scene", tc.spec.scene},
             {"method", tc.spec.method},
-            {"env", tc.spec.env},
+            {"env", environment_label(tc.spec.env, tc.spec.env_name)},
             {"options", tc.spec.options.values()},
             {"variant", tc.variant},
             {"display", tc.display ? display_json(*tc.display) : json()},
             {"tags", tc.tags},
-            {"bless_command", bless_command(tc)},
+            {"bless_command", bless_command(tc, store)},
             {"comparisons", json::array()},
             {"accuracy", nullptr},
             {"driver_mismatch", nullptr}};
@@ -102,6 +103,16 @@ void record_images(TestRun& t, const RenderResult& rr) {
     t.r["layout"] = t.art.layout(rr.coverage);
 }
 
+// A file environment must be the one the golden was made from (its content hash in the sidecar): an
+// edited HDRI used to be judged against the old truth and baselines without a word.
+void check_environment_unchanged(const TestCase& tc, const RenderResult& rr, const std::string& recorded, const fs::path& golden,
+                                 const std::string& fix) {
+    const std::string now = rr.provenance.contains("env_hash") ? rr.provenance["env_hash"].get<std::string>() : "";
+    if (!is_environment_file(tc.spec.env) || recorded.empty() || now.empty() || recorded == now) return;
+    throw InputError(fmt::format("{}: its content changed since {} was made from it (content hash {} there, {} now); {}",
+                                 tc.spec.env, golden.string(), recorded, now, fix));
+}
+
 // The approved baselines and, when there is one, the cost approved with it and the platform it was
 // blessed on (a difference is named in the message of a test that does not pass).
 BaselineOutcome check_baselines(TestRun& t, const RenderResult& rr) {
@@ -111,6 +122,14 @@ BaselineOutcome check_baselines(TestRun& t, const RenderResult& rr) {
         t.add(base.comparison.verdict, base.comparison.message);
         return base;
     }
+    // The truth was made from the old file too: it is re-rendered first (bless measures the accuracy against it).
+    const std::string rebless = "re-bless after looking at it: " + bless_command(t.tc, t.store);
+    check_environment_unchanged(
+        t.tc, rr,
+        (base.golden.provenance.value("env_hash", json()).is_string() ? base.golden.provenance["env_hash"].get<std::string>()
+                                                                      : ""),
+        base.golden.image_path,
+        t.tc.reference ? "re-render its truth: " + truth_command(t.tc.spec, t.store) + " --force; " + rebless : rebless);
     t.r["comparisons"].back()["approved"] = baseline_facts(base.golden.provenance);
     t.add(base.comparison.verdict, base.comparison.message.empty() ? "" : "baseline: " + base.comparison.message);
     const Comparison cost = cost_comparison(t.tc, rr, base);
@@ -130,7 +149,7 @@ void check_approved_accuracy(const TestRun& t, const BaselineOutcome& base) {
     if (!t.tc.baseline || base.missing || t.tc.reference_band.empty()) return;
     const json accuracy = approved_accuracy(base);
     const std::string side = fs::path(base.golden.image_path).replace_extension(".json").string();
-    const std::string fix = "; re-create it with: " + bless_command(t.tc);
+    const std::string fix = "; re-create it with: " + bless_command(t.tc, t.store);
     if (!accuracy.is_object())
         throw InputError(side + ": \"accuracy\" is " + (accuracy.is_null() ? "missing" : "not an object") +
                          " (the test's reference_band judges it)" + fix);
@@ -146,8 +165,10 @@ cv::Mat check_reference(TestRun& t, const RenderResult& rr, const BaselineOutcom
     auto ref = t.store.reference(t.tc.spec);
     if (!ref)
         throw InputError(t.store.reference_path(t.tc.spec).string() +
-                         ": no reference golden, and the test asks for one (\"reference\": true); create it with "
-                         "iblcheck truth (scripts/regenerate_reference_goldens.sh), or set \"reference\": false in the suite");
+                         ": no reference golden, and the test asks for one (\"reference\": true); create it with: " +
+                         truth_command(t.tc.spec, t.store) + " (or set \"reference\": false in the suite)");
+    check_environment_unchanged(t.tc, rr, truth_env_hash(ref->provenance), ref->image_path,
+                                "re-render the truth with: " + truth_command(t.tc.spec, t.store));
     check_approved_accuracy(t, base);
     Comparison c = judge_against_truth(t.tc, rr, *ref, t.store, approved_accuracy(base), t.art, t.flip_threads, t.r);
     t.r["comparisons"].push_back(to_json(c));
@@ -185,7 +206,7 @@ Verdict decide(TestRun& t) {
 
 json run_test(const TestCase& tc, Worker& w, const GoldenStore& store, const std::filesystem::path& out_dir, int flip_threads,
               int timing_repeats, bool& shader_error) {
-    TestRun t{tc, w, store, Artefacts::for_test(out_dir, tc.name), flip_threads, test_header(tc), {}, {}};
+    TestRun t{tc, w, store, Artefacts::for_test(out_dir, tc.name), flip_threads, test_header(tc, store), {}, {}};
     const auto t0 = std::chrono::steady_clock::now();
     cv::Mat image;
     try {

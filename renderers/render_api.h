@@ -14,6 +14,7 @@ struct TestSpec {
     std::string scene = "sphere";
     std::string method = "mobile"; // mobile | sampled | reference
     std::string env = "studio";
+    std::string env_name;      // a file environment's stable name (test names, golden keys); empty: its file name
     int width = 0, height = 0; // 0: the scene's default size
     OptionMap options;         // material + method variants, one spelling everywhere
     int frame = 0;             // temporal scenes: frame index

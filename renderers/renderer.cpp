@@ -109,7 +109,7 @@ RenderResult Renderer::render(const TestSpec& spec) {
     }
     double wall_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     r.provenance["scene"] = spec.scene;
-    r.provenance["env"] = spec.env;
+    r.provenance["env"] = environment_label(spec.env, spec.env_name); // no machine's absolute path in a sidecar
     r.provenance["env_hash"] = env.content_hash;
     r.provenance["env_negatives_clamped"] = env.negatives_clamped;
     r.provenance["options"] = spec.options.values();

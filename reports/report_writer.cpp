@@ -202,7 +202,7 @@ void summary_section(std::string& o, const json& results, const std::vector<cons
     json arr = json::array();
     for (const json* t : tests) arr.push_back(*t);
     const std::string all_line = rebless_all_line(arr, bless_argument(tests, "--suite "), bless_argument(tests, "--shader "));
-    const size_t colon = all_line.find(": iblcheck bless");
+    const size_t colon = all_line.find("): ") == std::string::npos ? std::string::npos : all_line.find("): ") + 1;
     if (colon != std::string::npos)
         fmt::format_to(out,
                        "<div class=\"cmd bless-all\"><span class=\"lbl\">{}</span><pre><code>{}</code></pre><button "

@@ -91,18 +91,21 @@ std::vector<std::string> verdict_details(const json& test) {
 }
 
 std::string rebless_all_line(const json& tests, const std::string& suite_arg, const std::string& shader_arg) {
-    std::string filter;
+    std::string filter, program = "iblcheck", goldens;
     int n = 0;
     for (const json& t : tests) {
         const std::string v = str(t, "verdict");
         if (v != "fail" && v != "missing-golden") continue;
         filter += (filter.empty() ? "" : "|") + glob_escape(str(t, "name"));
-        ++n;
+        // The binary the tests' own bless commands name (the one that ran: build/iblcheck after scripts/run.sh).
+        const std::string b = str(t, "bless_command");
+        if (n++ == 0 && b.find(" bless --suite ") != std::string::npos) program = b.substr(0, b.find(" bless --suite "));
+        if (n == 1 && b.find(" --goldens ") != std::string::npos) goldens = b.substr(b.find(" --goldens ")); // the same store
     }
     if (!n) return "";
-    return fmt::format("approve all {} failure{} (after looking at them): iblcheck bless --suite {}{} --filter {}", n,
-                       n == 1 ? "" : "s", shell_quote(suite_arg),
-                       shader_arg.empty() ? "" : " --shader " + shell_quote(shader_arg), shell_quote(filter));
+    return fmt::format("approve all {} failure{} (after looking at them): {} bless --suite {}{} --filter {}{}", n,
+                       n == 1 ? "" : "s", program, shell_quote(suite_arg),
+                       shader_arg.empty() ? "" : " --shader " + shell_quote(shader_arg), shell_quote(filter), goldens);
 }
 
 } // namespace iblcheck::report

@@ -8,6 +8,7 @@
 #include "compare_command.h"
 #include "harness/cli/version.h"
 #include "harness/common/errors.h"
+#include "harness/common/program.h"
 #include "harness/common/shell_quote.h"
 
 int main(int argc, char** argv) {
@@ -22,8 +23,10 @@ int main(int argc, char** argv) {
     iblcheck::cli::register_run_commands(app, exit_code);
     iblcheck::cli::register_report_command(app, exit_code);
     iblcheck::cli::register_truth_command(app, exit_code);
+    // The printed bless and truth commands name this binary as the user reaches it (program.h).
+    iblcheck::set_program_name(iblcheck::program_from_self());
     {
-        std::string line = "iblcheck";
+        std::string line = iblcheck::program_name();
         for (int i = 1; i < argc; ++i) line += " " + iblcheck::shell_arg(argv[i]); // the report's Copy button pastes it
         iblcheck::cli::set_invocation(line);
     }

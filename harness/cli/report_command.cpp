@@ -1,10 +1,14 @@
 #include "harness/cli/report_command.h"
 
 #include <filesystem>
+#include <fstream>
 
 #include <fmt/core.h>
 
 #include "harness/common/errors.h"
+#include "harness/common/output_files.h"
+#include "harness/junit.h"
+#include "reports/merge_shards.h"
 #include "reports/report_writer.h"
 
 namespace iblcheck::cli {
@@ -19,30 +23,68 @@ void check_report_folder(const std::filesystem::path& out, bool force) {
     if (!std::filesystem::is_empty(out, ec))
         throw UsageError("--out " + out.string() + ": holds files (an earlier report?); pass --force to write over them");
 }
+// The folder a results file names its images from.
+std::filesystem::path folder_of(const std::filesystem::path& results_file) {
+    return results_file.parent_path().empty() ? std::filesystem::path(".") : results_file.parent_path();
+}
+
+// Several shards: merged (reports/merge_shards.h) into --out, with each shard's images copied beside the
+// merged results.json (a test's images are under images/<test>/, so the shards' never collide; the
+// shared truth images are the same file in every shard).
+nlohmann::json merge_into(const std::vector<std::string>& files, const std::filesystem::path& out) {
+    namespace fs = std::filesystem;
+    std::vector<report::Shard> shards;
+    for (const std::string& f : files) shards.push_back({f, report::read_results(f)});
+    nlohmann::json merged = report::merge_shards(shards);
+    std::error_code ec;
+    fs::create_directories(out, ec);
+    if (ec) throw InputError(out.string() + ": cannot create the report folder: " + ec.message());
+    for (const report::Shard& s : shards) {
+        const fs::path images = folder_of(s.file) / "images";
+        if (!fs::is_directory(images)) continue;
+        fs::copy(images, out / "images", fs::copy_options::recursive | fs::copy_options::skip_existing, ec);
+        if (ec) throw InputError(images.string() + ": cannot copy into " + (out / "images").string() + ": " + ec.message());
+    }
+    std::ofstream f(out / "results.json");
+    f << merged.dump(1) << "\n";
+    f.close();
+    if (!f) throw InputError((out / "results.json").string() + ": cannot write");
+    return merged;
+}
 } // namespace
 
 void register_report_command(CLI::App& app, int& exit_code) {
     struct Args {
-        std::string results, out, history;
+        std::vector<std::string> results;
+        std::string out, history, junit;
         bool force = false;
     };
     auto args = std::make_shared<Args>();
-    auto* cmd = app.add_subcommand("report", "Rebuild the static HTML report from a stored results JSON");
-    cmd->add_option("results", args->results, "results.json written by `iblcheck run`")->required();
+    auto* cmd = app.add_subcommand("report", "Rebuild the static HTML report from stored results JSON; several results "
+                                             "files (the shards of one run) are merged into one report");
+    cmd->add_option("results", args->results,
+                    "results.json written by `iblcheck run`; several: the shards of one run (`run --shard i/n`), "
+                    "merged (same suite and commit, every shard once) into --out/results.json")
+        ->required();
     cmd->add_option("--out", args->out, "folder for index.html and the images it shows")->required();
+    cmd->add_option("--junit", args->junit, "also write JUnit XML of the (merged) results");
     cmd->add_option("--history", args->history, "history file (JSON lines, one entry per run) for trend lines");
-    cmd->add_flag("--force", args->force, "write into an --out folder that holds files (index.html and images are overwritten)");
+    cmd->add_flag("--force", args->force,
+                  "write into an --out folder that holds files (index.html and images are overwritten), and over --junit");
     cmd->callback([args, &exit_code] {
         namespace fs = std::filesystem;
-        const fs::path results_file(args->results);
         check_report_folder(args->out, args->force);
-        const nlohmann::json results = report::read_results(results_file);
+        check_output_file(args->junit, "--junit", args->force, {});
+        const bool merge = args->results.size() > 1;
+        const nlohmann::json results =
+            merge ? merge_into(args->results, args->out) : report::read_results(fs::path(args->results[0]));
         std::vector<nlohmann::json> history;
         if (!args->history.empty()) history = report::read_history(args->history);
-        fs::path dir = results_file.parent_path();
-        if (dir.empty()) dir = ".";
+        const fs::path dir = merge ? fs::path(args->out) : folder_of(args->results[0]);
         report::write_report(results, dir, args->out, history);
-        fmt::print("report: {}\n", (fs::path(args->out) / "index.html").string());
+        if (!args->junit.empty()) write_junit(results, args->junit);
+        fmt::print("report: {}{}\n", (fs::path(args->out) / "index.html").string(),
+                   merge ? fmt::format(" ({} shards merged: {} tests)", args->results.size(), results["tests"].size()) : "");
         exit_code = kExitPass;
     });
 }

@@ -21,6 +21,7 @@
 #include "harness/common/output_files.h"
 #include "harness/common/shell_quote.h"
 #include "harness/golden_store.h"
+#include "renderers/environments/environment.h"
 #include "renderers/reference/monte_carlo_golden.h"
 #include "renderers/reference/truth_golden.h"
 
@@ -60,19 +61,25 @@ class ProgressLine {
 };
 // The command line, as parsed.
 struct TruthArgs {
-    std::string scene = "roughness_sweep", env, out, integrator = "quadrature", compare, tiles, command;
+    std::string scene = "roughness_sweep", env, env_name, size, goldens, out, integrator = "quadrature", compare, tiles, command;
     std::vector<std::string> sets;
     bool force = false;
     int frames = 0, spp = kReferenceDefaultSpp, seed = 0;
     bool spp_given = false, seed_given = false;
 };
 
-// The golden's path (the golden store's key unless --out), refused if it or its sidecar exists without --force,
-// and always when it is an input (the --env file, or --compare's OLD.exr, which it would then be compared with).
+// The golden's path: --out, else the golden store (--goldens, else the runner's default) under exactly the
+// key a suite test with this scene, environment, size and material reads (reference/<key>.exr). It used to
+// be <key>.exr in the current folder, with a key the runner did not read. Refused if it or its sidecar
+// exists without --force, and always when it is an input (the --env file, or --compare's OLD.exr).
 std::string golden_path(const TruthArgs& a, const TestSpec& keyed) {
     namespace fs = std::filesystem;
-    std::string exr =
-        a.out.empty() ? reference_key(keyed) + (a.frames > 0 ? "__frames=" + std::to_string(a.frames) : "") + ".exr" : a.out;
+    const GoldenStore store(a.goldens);
+    std::string exr = !a.out.empty() ? a.out
+                      : a.frames > 0 ? store.reference_sequence_path(keyed, a.frames).string()
+                                     : store.reference_path(keyed).string();
+    std::error_code ec;
+    if (a.out.empty()) fs::create_directories(fs::path(exr).parent_path(), ec); // a new golden root: its reference/
     for (const fs::path& p : {fs::path(exr), fs::path(exr).replace_extension(".json")})
         check_output_file(p, "--out", a.force, {a.env, a.compare});
     return exr;
@@ -83,6 +90,7 @@ std::string golden_path(const TruthArgs& a, const TestSpec& keyed) {
 std::string recorded_command(const TruthArgs& a, const std::string& env) {
     if (!a.command.empty()) return a.command;
     std::string c = fmt::format("iblcheck truth --scene {} --env {}", shell_arg(a.scene), shell_arg(env));
+    if (!a.size.empty()) c += " --size " + a.size;
     if (a.integrator == "monte_carlo") c += fmt::format(" --integrator monte_carlo --spp {} --seed {}", a.spp, a.seed);
     for (auto& s : a.sets) c += " --set " + shell_arg(s);
     if (a.frames > 0) c += " --frames " + std::to_string(a.frames);
@@ -98,6 +106,14 @@ std::pair<int, int> parse_tiles(const std::string& t) {
     if (std::sscanf(t.c_str(), "%dx%d%c", &w, &h, &rest) != 2 || w < 1 || h < 1)
         throw UsageError("--tiles: expected WxH, e.g. 48x48, got '" + t + "'");
     return {w, h};
+}
+
+// --size WxH, as a suite's "size" (the key gets __WxH, as the runner's does).
+void parse_truth_size(const std::string& s, int& w, int& h) {
+    if (s.empty()) return;
+    char rest = 0;
+    if (std::sscanf(s.c_str(), "%dx%d%c", &w, &h, &rest) != 2 || w < 1 || h < 1 || w > 8192 || h > 8192)
+        throw UsageError("--size '" + s + "' is not WxH (1..8192)");
 }
 
 void check_combinations(const TruthArgs& a) {
@@ -172,17 +188,19 @@ int run_truth(const TruthArgs& a) {
     req.spec.method = "reference";
     req.spec.scene = a.scene;
     req.spec.env = a.env;
+    req.spec.env_name = a.env_name;
+    if (!a.env_name.empty() && !is_environment_file(a.env))
+        throw UsageError("--env-name names an environment file; " + a.env + " is a built-in environment");
+    parse_truth_size(a.size, req.spec.width, req.spec.height);
     for (auto& s : a.sets) req.spec.options.set_from_string(s);
-    // The file name from the golden store's key, with the environment as recorded (a path: its name).
-    TestSpec keyed = req.spec;
-    keyed.env = truth::portable_env_spec(a.env);
-    req.out_exr = golden_path(a, keyed);
-    req.command = recorded_command(a, keyed.env);
+    // The golden store's key: the environment by its stable name (environment_label), never its folder.
+    req.out_exr = golden_path(a, req.spec);
+    req.command = recorded_command(a, truth::portable_env_spec(req.spec));
     int rc;
     if (a.integrator == "monte_carlo") {
         rc = run_monte_carlo(a, req);
     } else {
-        ProgressLine line(a.scene + " / " + keyed.env);
+        ProgressLine line(a.scene + " / " + truth::portable_env_spec(req.spec));
         req.progress = [&line](double f) { line(f); };
         rc = a.frames > 0 ? run_sequence(req, a.frames, line) : run_quadrature(req, line);
     }
@@ -198,8 +216,13 @@ void register_truth_command(CLI::App& app, int& exit_code) {
     cmd->add_option("--scene", a.scene, "Scene name (iblcheck list)")->capture_default_str();
     cmd->add_option("--env", a.env, "Environment: a spec (iblcheck list) or a path to your own .exr/.hdr")->required();
     cmd->add_option("--out", a.out,
-                    "Golden EXR to write (default: <reference key>.exr in the current folder); the "
-                    "sidecar is the same path with .json");
+                    "Golden EXR to write (default: the golden store's reference/<key>.exr, the file a suite test "
+                    "with this scene, environment, size and material reads); the sidecar is the same path with .json");
+    cmd->add_option("--goldens", a.goldens, "Golden folder to write into (default: goldens/, as run and bless)");
+    cmd->add_option("--env-name", a.env_name,
+                    "The stable name of an environment file, as the suite gives it ({\"file\": ..., \"name\": ...}; "
+                    "default: its file name): the golden's key and the name recorded in its sidecar");
+    cmd->add_option("--size", a.size, "Image size WxH, as the suite test's \"size\" (default: the scene's)");
     cmd->add_option("--set", a.sets,
                     "Option key=value (repeatable): material options, env_rotation, threads, "
                     "truth_tolerance (the coarser level's pixel tolerance)");

@@ -162,6 +162,15 @@ std::vector<EnvironmentInfo> environment_catalog() {
     return out;
 }
 
+bool is_environment_file(const std::string& spec) {
+    return spec.rfind("constant:", 0) != 0 && spec.rfind("blender:", 0) != 0 && spec != "studio" && spec != "sky_sun";
+}
+
+std::string environment_label(const std::string& spec, const std::string& name) {
+    if (!is_environment_file(spec)) return spec;
+    return name.empty() ? std::filesystem::path(spec).filename().string() : name;
+}
+
 Environment load_environment(const std::string& spec) {
     if (spec.rfind("constant:", 0) == 0) {
         OptionMap o;

@@ -42,6 +42,13 @@ std::vector<EnvironmentInfo> environment_catalog();
 // Throws UsageError for an unknown spec (listing valid ones), InputError for a bad file.
 Environment load_environment(const std::string& spec);
 
+// Whether `spec` is a path to a file (not a built-in environment such as studio or blender:city).
+bool is_environment_file(const std::string& spec);
+// The environment's stable name, as test names, golden keys and sidecars give it (never a machine's
+// absolute path): a built-in spec as written; a file by `name` when one is given, else its file name
+// (city.exr: a file name has an extension, so it never takes a built-in environment's key).
+std::string environment_label(const std::string& spec, const std::string& name = "");
+
 // Hex FNV-1a-64 of an image's bytes, row by row (Environment::content_hash).
 std::string fnv1a64_hex(const cv::Mat& m);
 

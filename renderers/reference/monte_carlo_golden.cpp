@@ -55,7 +55,7 @@ MonteCarloGoldenWritten write_monte_carlo_golden(const MonteCarloGoldenRequest& 
     meta["width"] = nf.image_a.cols;
     meta["height"] = nf.image_a.rows;
     meta["env"] = {
-        {"spec", portable_env_spec(spec.env)}, {"content_hash", env.content_hash}, {"negatives_clamped", env.negatives_clamped}};
+        {"spec", portable_env_spec(spec)}, {"content_hash", env.content_hash}, {"negatives_clamped", env.negatives_clamped}};
     meta["spp"] = req.spp;
     meta["time_s"] = time_s;
     meta["command"] = req.command;

@@ -16,10 +16,7 @@
 
 namespace iblcheck::truth {
 
-std::string portable_env_spec(const std::string& spec) {
-    if (spec.rfind("constant:", 0) == 0 || spec.rfind("blender:", 0) == 0 || spec == "studio" || spec == "sky_sun") return spec;
-    return std::filesystem::path(spec).filename().string();
-}
+std::string portable_env_spec(const TestSpec& spec) { return environment_label(spec.env, spec.env_name); }
 
 std::string utc_now() {
     char date[64];
@@ -127,14 +124,14 @@ GoldenWritten write_truth_golden(const GoldenRequest& req) {
                           {"met", out.criterion_met}};
     nlohmann::json prov = r.result.provenance;
     prov.erase("error_bound");
-    prov["env"]["spec"] = portable_env_spec(req.spec.env);
+    prov["env"]["spec"] = portable_env_spec(req.spec);
     const std::filesystem::path exr(req.out_exr);
     out.meta = {{"scene", req.spec.scene},
                 {"options", req.spec.options.canonical()},
                 {"width", r.fine.image.cols},
                 {"height", r.fine.image.rows},
                 {"env",
-                 {{"spec", portable_env_spec(req.spec.env)},
+                 {{"spec", portable_env_spec(req.spec)},
                   {"content_hash", env.content_hash},
                   {"negatives_clamped", env.negatives_clamped}}},
                 {"integrator", "quadrature"},
@@ -170,7 +167,7 @@ nlohmann::json write_truth_sequence_golden(const SequenceRequest& req) {
     }
     cv::Mat strip;
     cv::vconcat(seq.frames, strip);
-    const std::string portable = portable_env_spec(req.spec.env);
+    const std::string portable = portable_env_spec(req.spec);
     nlohmann::json meta = {
         {"scene", req.spec.scene},
         {"options", req.spec.options.canonical()},
