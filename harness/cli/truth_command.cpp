@@ -173,6 +173,9 @@ int run_truth(const TruthArgs& a) {
     req.spec.scene = a.scene;
     req.spec.env = a.env;
     for (auto& s : a.sets) req.spec.options.set_from_string(s);
+    if (req.spec.options.has("split_sum")) // a rung of `iblcheck explain`, not a truth: never a golden
+        throw UsageError(
+            "--set split_sum: the split sum's rungs are approximations, not a truth; `iblcheck explain` renders them");
     // The file name from the golden store's key, with the environment as recorded (a path: its name).
     TestSpec keyed = req.spec;
     keyed.env = truth::portable_env_spec(a.env);
