@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
     iblcheck::cli::register_run_commands(app, exit_code);
     iblcheck::cli::register_report_command(app, exit_code);
     iblcheck::cli::register_truth_command(app, exit_code);
+    iblcheck::cli::register_explain_command(app, exit_code);
     {
         std::string line = "iblcheck";
         for (int i = 1; i < argc; ++i) line += " " + iblcheck::shell_arg(argv[i]); // the report's Copy button pastes it
