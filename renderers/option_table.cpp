@@ -80,6 +80,10 @@ const std::vector<OptionInfo>& option_catalog() {
          "quadrature truth (default; monte_carlo when spp is set)"},
         {"truth_tolerance", "0.001", ">0", "reference", "", "quadrature truth: the coarser level's per-pixel tolerance"},
         {"threads", "0", ">=0", "reference", "", "CPU threads (0: all)"},
+        {"split_sum", "off", "off|exact|env_brdf_approx", "reference", "",
+         "quadrature truth: off renders the truth; exact / env_brdf_approx the split sum's rungs of `iblcheck explain` "
+         "(prefiltered radiance at n = v = R times the exact DFG or EnvBRDFApprox, plus the exact diffuse; the coarse level "
+         "only; renderers/reference/split_sum.h)"},
     };
     return table;
 }

@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
     iblcheck::cli::register_truth_command(app, exit_code);
     // The printed bless and truth commands name this binary as the user reaches it (program.h).
     iblcheck::set_program_name(iblcheck::program_from_self());
+    iblcheck::cli::register_explain_command(app, exit_code);
     {
         std::string line = iblcheck::program_name();
         for (int i = 1; i < argc; ++i) line += " " + iblcheck::shell_arg(argv[i]); // the report's Copy button pastes it

@@ -193,6 +193,9 @@ int run_truth(const TruthArgs& a) {
         throw UsageError("--env-name names an environment file; " + a.env + " is a built-in environment");
     parse_truth_size(a.size, req.spec.width, req.spec.height);
     for (auto& s : a.sets) req.spec.options.set_from_string(s);
+    if (req.spec.options.has("split_sum")) // a rung of `iblcheck explain`, not a truth: never a golden
+        throw UsageError(
+            "--set split_sum: the split sum's rungs are approximations, not a truth; `iblcheck explain` renders them");
     // The golden store's key: the environment by its stable name (environment_label), never its folder.
     req.out_exr = golden_path(a, req.spec);
     req.command = recorded_command(a, truth::portable_env_spec(req.spec));

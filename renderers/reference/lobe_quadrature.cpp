@@ -71,6 +71,12 @@ IBLCHECK_CLONES_HASWELL void fcos4(const MaterialLobe& L, const ShadingPoint& s,
         const double x = 1 - std::min(1.0, std::max(0.0, vh));
         x5[k] = x * x * x * x * x;
         dvn[k] = d * vis * nl[k];
+        if (L.prefilter) dvn[k] = d * nl[k] * L.inv_norm; // split_sum.h: D·(n·l)/norm, no V, no F
+    }
+    if (L.prefilter) {
+        for (int q = 0; q < 3; ++q)
+            for (int k = 0; k < 4; ++k) out[q][k] += dvn[k];
+        return;
     }
     for (int q = 0; q < 3; ++q)
         for (int k = 0; k < 4; ++k) out[q][k] += dvn[k] * (L.f0[q] + (1 - L.f0[q]) * x5[k]);

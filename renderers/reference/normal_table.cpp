@@ -1,6 +1,8 @@
 // L_o tabulated over normals, adaptively (normal_table.h).
 #include "renderers/reference/normal_table.h"
 
+#include "renderers/reference/split_sum.h"
+
 #include <algorithm>
 #include <array>
 #include <atomic>
@@ -105,7 +107,10 @@ struct NormalTable::Builder {
         // (each from its own refinement) averaging as footprint/s: they may be as much looser too.
         q.tolerance /= std::clamp(dot(n, t.v_) + tp.weight_offset, 0.05, 1.0);
         if (s > 0 && s < tp.footprint) q.tolerance *= tp.footprint / s;
-        shade(env, lobe, shading_point(n, t.v_, lobe), q, rgb, &st);
+        if (lobe.split_sum != SplitSum::off)
+            shade_split_sum(env, lobe, shading_point(n, t.v_, lobe), q, rgb, &st);
+        else
+            shade(env, lobe, shading_point(n, t.v_, lobe), q, rgb, &st);
         ++nodes, evals += st.evaluations;
         for (int q = 0; q < 3; ++q) out[q] = float(rgb[q]);
     }

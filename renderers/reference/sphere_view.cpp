@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "harness/common/errors.h"
+#include "renderers/reference/split_sum.h"
 
 namespace iblcheck::truth {
 
@@ -70,6 +71,12 @@ void SphereView::mirror(const EnvPyramid& env, double x, double y, double rgb[3]
     const ShadingPoint s = shading_point(bumped_normal(x, y), back_, lobe_);
     double L[3];
     env.radiance(2 * s.nv * s.n - s.v, L);
+    if (lobe_.split_sum == SplitSum::env_brdf_approx) { // split_sum.h: the fit's (A, B) at r = 0
+        const Dfg g = env_brdf_approx(0, s.nv);
+        for (int q = 0; q < 3; ++q) rgb[q] = (lobe_.f0[q] * g.a + g.b) * L[q];
+        return;
+    }
+    // (split_sum=exact: the exact DFG at α = 0 is F(n·v) itself, so the split sum is exact here.)
     for (int q = 0; q < 3; ++q) rgb[q] = model::f_schlick(lobe_.f0[q], s.nv) * L[q];
 }
 

@@ -17,6 +17,7 @@ class SphereView {
     const Disc& disc() const { return disc_; }
     const Sphere& sphere() const { return sphere_; }
     const MaterialLobe& lobe() const { return lobe_; }
+    void set_split_sum(SplitSum m) { lobe_.split_sum = m; } // split_sum.h's rungs
     V3 view() const { return back_; }
     V3 right() const { return right_; }
     V3 up() const { return up_; }

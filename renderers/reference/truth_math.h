@@ -20,6 +20,11 @@ inline double rgb_size(const double c[3]) { return (std::fabs(c[0]) + std::fabs(
 // Which lobes of the model to evaluate (option lobes = all|diffuse|specular, as the Monte Carlo integrator).
 enum class Lobes { all, diffuse, specular };
 
+// The split-sum rungs of `iblcheck explain` (option split_sum, split_sum.h): off is the truth; exact
+// shades every node as P(R, α)·(F0·A + B) + the exact diffuse, with the exact DFG (A, B);
+// env_brdf_approx the same with Karis/Lazarov's EnvBRDFApprox for (A, B).
+enum class SplitSum { off, exact, env_brdf_approx };
+
 // One sphere's material constants. α < kMirrorAlpha (roughness < 0.01, in practice r = 0) makes the
 // specular lobe the delta F(n·v)·L(reflect(v)), as in the Monte Carlo integrator.
 inline constexpr double kMirrorAlpha = 1e-4;
@@ -28,6 +33,11 @@ struct MaterialLobe {
     double f0[3] = {0, 0, 0};
     double kd[3] = {0, 0, 0}; // (1 − m)·c/π
     bool diffuse = false, specular = false, mirror = false;
+    SplitSum split_sum = SplitSum::off;
+    // The prefilter lobe of the split sum (split_sum.h): the specular term is D(h)·(n·l)·inv_norm per
+    // channel, no V, no F (Karis's prefilter weighting, evaluated at n = v = R).
+    bool prefilter = false;
+    double inv_norm = 0;
     bool glossy() const { return specular && !mirror; } // a continuous specular lobe to integrate
 };
 inline MaterialLobe material_lobe(const Material& m, Lobes lobes) {
@@ -91,6 +101,10 @@ inline void fcos(const MaterialLobe& L, const ShadingPoint& s, V3 l, double out[
     const double nh = dot(s.n, h) * inv, vh = dot(s.v, h) * inv;
     const double t = nh * nh * (L.a2 - 1) + 1;
     const double d = L.a2 / (kPi * t * t);
+    if (L.prefilter) {
+        for (int i = 0; i < 3; ++i) out[i] += spec_weight * d * nl * L.inv_norm;
+        return;
+    }
     const double vis = 0.5 / (nl * s.gv + s.nv * std::sqrt(nl * nl * (1 - L.a2) + L.a2));
     const double x = 1 - std::clamp(vh, 0.0, 1.0), x5 = x * x * x * x * x;
     const double dvn = spec_weight * d * vis * nl;

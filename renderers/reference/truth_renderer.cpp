@@ -68,9 +68,9 @@ std::shared_ptr<const NormalTable> normal_table(const EnvPyramid& env, const std
     static std::vector<std::pair<std::string, std::shared_ptr<const NormalTable>>> cache;
     const V3 v = sv.view(), r = sv.right(), u = sv.up();
     const std::string key =
-        fmt::format("{}|{}|{}|{},{},{}|{},{},{}|{},{},{}|{},{},{}|{}|{}", env_key, L.alpha, int(L.diffuse) + 2 * int(L.specular),
-                    L.f0[0], L.f0[1], L.f0[2], L.kd[0], L.kd[1], L.kd[2], v.x, v.y, v.z, r.x, r.y, r.z, acc.json().dump(),
-                    int(sv.sphere().bump_amplitude > 0));
+        fmt::format("{}|{}|{}|{},{},{}|{},{},{}|{},{},{}|{},{},{}|{}|{}", env_key, L.alpha,
+                    int(L.diffuse) + 2 * int(L.specular) + 4 * int(L.split_sum), L.f0[0], L.f0[1], L.f0[2], L.kd[0], L.kd[1],
+                    L.kd[2], v.x, v.y, v.z, r.x, r.y, r.z, acc.json().dump(), int(sv.sphere().bump_amplitude > 0));
     {
         std::lock_guard<std::mutex> lock(m);
         for (auto& [k, t] : cache)
@@ -140,9 +140,10 @@ void shade_pixel(const SphereView& sv, const EnvPyramid& env, const NormalTable*
 } // namespace
 
 TruthImage render_truth_level(const Scene& scene, int W, int H, const EnvPyramid& env, const std::string& env_key, Lobes lobes,
-                              const TruthAccuracy& acc, int threads, const Progress& progress) {
+                              const TruthAccuracy& acc, int threads, const Progress& progress, SplitSum split_sum) {
     auto t0 = std::chrono::steady_clock::now();
-    const std::vector<SphereView> views = sphere_views(scene, W, H, lobes);
+    std::vector<SphereView> views = sphere_views(scene, W, H, lobes);
+    for (SphereView& v : views) v.set_split_sum(split_sum);
     // The spheres' normal tables first: most of the level's work (half of its progress).
     std::vector<std::shared_ptr<const NormalTable>> tables(views.size());
     long table_evals = 0, table_nodes = 0;
@@ -225,6 +226,36 @@ TruthImage render_truth_level(const Scene& scene, int W, int H, const EnvPyramid
 
 namespace iblcheck::truth {
 
+namespace {
+// A split-sum rung (split_sum.h): one level, the coarse one (half the time of the pair). It is not a
+// truth: its provenance says so and carries no error bound of its own; its quadrature error is the
+// coarse level's, which the truth's stated bound (coarse against fine) measures for the scene.
+RenderResult split_sum_result(const TestSpec& spec, const TruthImage& img, const TruthAccuracy& acc, const std::string& split,
+                              int threads, const std::string& lobes, const Environment& env,
+                              std::chrono::steady_clock::time_point t0) {
+    RenderResult res;
+    const double total_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    res.image = img.image;
+    res.timings.push_back({"reference_cpu", total_s * 1000, false, false});
+    res.texture_fetches_per_pixel = double(img.evaluations) / (double(img.image.cols) * img.image.rows);
+    res.provenance = {{"method", "reference"},
+                      {"integrator", "quadrature"},
+                      {"split_sum", split},
+                      {"deterministic", true},
+                      {"scene", spec.scene},
+                      {"options", spec.options.canonical()},
+                      {"width", img.image.cols},
+                      {"height", img.image.rows},
+                      {"threads", threads},
+                      {"lobes", lobes},
+                      {"env", {{"spec", env.spec.empty() ? spec.env : env.spec}, {"content_hash", env.content_hash}}},
+                      {"levels", {{"coarse", acc.json()}}},
+                      {"evaluations", {{"coarse", img.evaluations}}},
+                      {"time_s", total_s}};
+    return res;
+}
+} // namespace
+
 TruthRender render_truth(const TestSpec& spec, const Environment& env_in, const Progress& progress) {
     auto t0 = std::chrono::steady_clock::now();
     const Scene scene = build_scene(spec.scene, spec.options);
@@ -263,6 +294,13 @@ TruthRender render_truth(const TestSpec& spec, const Environment& env_in, const 
         return [&progress, lo, hi](double f) { progress(lo + (hi - lo) * f); };
     };
     const std::string env_key = env.content_hash + "@" + std::to_string(env.rotation_deg);
+    const std::string split_s = o.get_choice("split_sum", "off", {"off", "exact", "env_brdf_approx"});
+    if (split_s != "off") {
+        r.coarse = render_truth_level(scene, W, H, pyramid, env_key, lobes, acc, threads, progress,
+                                      split_s == "exact" ? SplitSum::exact : SplitSum::env_brdf_approx);
+        r.result = split_sum_result(spec, r.coarse, acc, split_s, threads, lobes_s, env, t0);
+        return r;
+    }
     r.coarse = render_truth_level(scene, W, H, pyramid, env_key, lobes, acc, threads, part(0, 0.33));
     r.fine = render_truth_level(scene, W, H, pyramid, env_key, lobes, acc.finer(), threads, part(0.33, 1));
     r.bound = compare_levels(r.coarse, r.fine, scene);

@@ -76,7 +76,9 @@ struct TruthRender {
 inline constexpr double kNearMirrorAlpha = 2e-3;
 
 // spec.options: the scene's options, env_rotation, lobes, threads, truth_tolerance (the coarse level's
-// pixel tolerance, default 1e-3; its env tolerance is a quarter of it). Throws UsageError for a
+// pixel tolerance, default 1e-3; its env tolerance is a quarter of it), split_sum (off: the truth;
+// exact | env_brdf_approx: split_sum.h's rungs, rendered at the coarse level only — its bound against
+// the finer level is the truth's own, measured on the truth (split_sum=off) render of the scene). Throws UsageError for a
 // perspective camera, overlapping silhouettes (the quadrature integrates each disc's footprint on its
 // own) or a near-mirror lobe on a smooth sphere (kNearMirrorAlpha).
 TruthRender render_truth(const TestSpec& spec, const Environment& env, const Progress& progress = {});
@@ -84,6 +86,7 @@ TruthRender render_truth(const TestSpec& spec, const Environment& env, const Pro
 // One level (tests, measurements). env_key identifies the environment and its rotation (the normal
 // tables of bumped spheres are cached under it across renders).
 TruthImage render_truth_level(const Scene& scene, int W, int H, const EnvPyramid& env, const std::string& env_key, Lobes lobes,
-                              const TruthAccuracy& acc, int threads, const Progress& progress = {});
+                              const TruthAccuracy& acc, int threads, const Progress& progress = {},
+                              SplitSum split_sum = SplitSum::off);
 
 } // namespace iblcheck::truth
