@@ -82,7 +82,12 @@ BudgetPlan plan_budget(const std::string& scene, const std::string& env, const O
         }
     }
     BudgetPlan plan;
-    plan.truth = {scene, "reference", env, 0, 0, shared};
+    auto spec_of = [&](const std::string& method) {
+        TestSpec t;
+        t.scene = scene, t.method = method, t.env = env, t.options = shared;
+        return t;
+    };
+    plan.truth = spec_of("reference");
     for (const auto& [k, v] : truth_only.values()) plan.truth.options.set(k, v);
     auto cpu_rung = [&](const std::string& mode, const std::string& label) {
         BudgetRung r{mode == "exact" ? "split_sum" : "env_brdf_approx", label, plan.truth};
@@ -91,7 +96,7 @@ BudgetPlan plan_budget(const std::string& scene, const std::string& env, const O
     };
     plan.ladder.push_back(cpu_rung("exact", "split sum, exact parts (n = v = R)"));
     plan.ladder.push_back(cpu_rung("env_brdf_approx", "EnvBRDFApprox for the exact DFG"));
-    TestSpec converged{scene, "mobile", env, 0, 0, shared};
+    TestSpec converged = spec_of("mobile");
     for (const auto& [k, v] : gpu.values()) converged.options.set(k, v);
     for (const auto& [k, v] : converged_gpu_values()) converged.options.set(k, v);
     plan.ladder.push_back({"mip_chain", "GPU converged: the prefiltered mip chain", converged});

@@ -117,7 +117,8 @@ TEST(ErrorBudget, SharesTelescopeAndIsolatedPlusInteractionIsTheTotal) {
 // (A + B)_approx − (A + B)_exact: at a sphere's centre (n·v = 1) 0.450 against 0.307 at r = 1.
 TEST(ErrorBudget, SplitSumRungsInTheWhiteFurnaceHaveTheirIndependentFigures) {
     const Environment env = load_environment("constant:1");
-    TestSpec spec{"furnace", "reference", "constant:1", 0, 0, {}};
+    TestSpec spec;
+    spec.scene = "furnace", spec.method = "reference", spec.env = "constant:1";
     spec.options.set("truth_tolerance", "0.004");
     spec.options.set("threads", "2");
     const cv::Mat truth = truth::render_truth(spec, env).result.image;
