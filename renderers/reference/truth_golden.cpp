@@ -147,6 +147,34 @@ GoldenWritten write_truth_golden(const GoldenRequest& req) {
     return out;
 }
 
+nlohmann::json sequence_criterion(double worst_ldr, double worst_flip, double worst_rel) {
+    const bool ldr = worst_ldr < kSequenceCriterionLdrFlip, hdr = worst_flip < kSequenceCriterionFlip,
+               rel = worst_rel < kSequenceCriterionRelativeRmse;
+    return {{"mean_flip_ldr_below", kSequenceCriterionLdrFlip},
+            {"mean_flip_ldr_met", ldr},
+            {"mean_flip_below", kSequenceCriterionFlip},
+            {"mean_flip_met", hdr},
+            {"relative_rmse_below", kSequenceCriterionRelativeRmse},
+            {"relative_rmse_met", rel},
+            {"relied_on", "mean_flip_ldr"},
+            {"met", ldr && hdr && rel},
+            {"still_golden_criterion",
+             {{"mean_flip_below", kCriterionFlip},
+              {"relative_rmse_below", kCriterionRelativeRmse},
+              {"mean_flip_met", worst_flip < kCriterionFlip},
+              {"relative_rmse_met", worst_rel < kCriterionRelativeRmse},
+              {"met", worst_flip < kCriterionFlip && worst_rel < kCriterionRelativeRmse}}},
+            {"justification",
+             "the temporal suite scores each specular_aa variant by LDR-FLIP against this truth: 0.035 and more (off on "
+             "sphere_field, fragment path); its 8x8-ray reference sequence, reported beside them, is 0.0176 from it. An "
+             "LDR-FLIP bound below 0.002 (under 6 % of the smallest variant distance, 11 % of the reference's) cannot "
+             "change a verdict or a ranking, and is the criterion the suite relies on. HDR-FLIP and relative RMSE are "
+             "bounded looser than a still golden's (0.002, 0.5 %): bumpy_sphere under sky_sun has the 1e5 sun's "
+             "reflection in a few pixels (worst pixels 58-85 % between the levels), sphere_field's small spheres are "
+             "mostly rim; the suite never compares the sequences' HDR radiance (renderers/reference/CONVERGENCE.md, "
+             "the temporal truth's criterion)"}};
+}
+
 nlohmann::json write_truth_sequence_golden(const SequenceRequest& req) {
     const Environment env = load_environment(req.spec.env);
     const TruthSequence seq = render_truth_sequence(req.spec, env, req.frames, req.bound_frames, req.progress);
@@ -186,7 +214,8 @@ nlohmann::json write_truth_sequence_golden(const SequenceRequest& req) {
           {"frames", bounds},
           {"relative_rmse_max", worst_rel},
           {"mean_flip_max", worst_flip},
-          {"mean_flip_ldr_max", worst_ldr}}},
+          {"mean_flip_ldr_max", worst_ldr},
+          {"criterion", sequence_criterion(worst_ldr, worst_flip, worst_rel)}}},
         {"threads", seq.threads},
         {"time_s", seq.seconds},
         {"command", req.command},

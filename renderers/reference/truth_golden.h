@@ -15,6 +15,23 @@ namespace iblcheck::truth {
 inline constexpr double kCriterionFlip = 0.002;
 inline constexpr double kCriterionRelativeRmse = 0.005;
 
+// The temporal truth's criterion (issue 28). The temporal suite scores each specular_aa variant by
+// LDR-FLIP against this truth, 0.035 and more (off on sphere_field); its reference sequence is 0.0176
+// from it. The sequence's own LDR-FLIP bound stays under 10 % of the smallest variant distance (0.002:
+// 6 %; 11 % of the reference's): the criterion the suite relies on. The HDR-FLIP and relative-RMSE
+// bounds are looser than the still goldens' (the sun's 1e5 reflection on bumpy_sphere under sky_sun,
+// the rims of sphere_field's small spheres: CONVERGENCE.md "The temporal truth's criterion"); they are
+// stated, recorded and required, but the suite never reads the sequences' HDR radiance.
+inline constexpr double kSmallestJudgedLdrFlip = 0.035;
+inline constexpr double kSequenceCriterionLdrFlip = 0.002;
+inline constexpr double kSequenceCriterionFlip = 0.003;
+inline constexpr double kSequenceCriterionRelativeRmse = 0.025;
+
+// The sidecar's error_bound.criterion of a temporal sequence from its worst bound frame's figures:
+// each bound with its `_met`, the still goldens' criterion with its verdict beside (for comparison),
+// the justification, and `met` (all three sequence bounds hold).
+nlohmann::json sequence_criterion(double worst_ldr_flip, double worst_flip, double worst_relative_rmse);
+
 struct GoldenRequest {
     TestSpec spec;       // method reference; the environment is loaded from spec.env
     std::string out_exr; // the golden; the sidecar is the same path with .json

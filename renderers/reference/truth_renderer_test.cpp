@@ -243,6 +243,22 @@ TEST(TruthRenderer, MirrorPixelsSumToTheEnvironmentIntegralWithinTheDepthCap) {
 // noise floor's; a temporal truth sequence keeps every bound frame's HDR-FLIP below 0.003 and relative
 // RMSE below 2.5 % (measured: up to 0.0028 and 1.9 %; its normal table at the old tolerance, 0.1, left
 // the sun's spots unresolved: 17 %).
+// The temporal sequences' criterion: met only when all three bounds hold; the LDR-FLIP one (the suite's
+// metric) is under 10 % of the smallest variant distance the temporal suite judges.
+TEST(TruthRenderer, SequenceCriterionIsMetOnlyWhenEveryBoundHolds) {
+    EXPECT_LE(kSequenceCriterionLdrFlip, 0.1 * kSmallestJudgedLdrFlip);
+    const nlohmann::json ok = sequence_criterion(0.0018, 0.0028, 0.0188); // sphere_field's 2026-11-26 figures
+    EXPECT_TRUE(ok.at("met").get<bool>());
+    EXPECT_FALSE(ok.at("still_golden_criterion").at("met").get<bool>()); // 1.88 % > 0.5 %: stated, not hidden
+    EXPECT_FALSE(ok.at("still_golden_criterion").at("relative_rmse_met").get<bool>());
+    EXPECT_EQ(ok.at("relied_on").get<std::string>(), "mean_flip_ldr");
+    const nlohmann::json ldr = sequence_criterion(0.0021, 0.0010, 0.001);
+    EXPECT_FALSE(ldr.at("mean_flip_ldr_met").get<bool>());
+    EXPECT_FALSE(ldr.at("met").get<bool>());
+    EXPECT_FALSE(sequence_criterion(0.0010, 0.0031, 0.001).at("met").get<bool>());
+    EXPECT_FALSE(sequence_criterion(0.0010, 0.0010, 0.026).at("met").get<bool>());
+}
+
 TEST(TruthRenderer, CommittedReferenceGoldensStateABoundThatHolds) {
     namespace fs = std::filesystem;
     int quadrature = 0, monte_carlo = 0, sequences = 0;
@@ -253,9 +269,20 @@ TEST(TruthRenderer, CommittedReferenceGoldensStateABoundThatHolds) {
         const std::string name = entry.path().filename().string();
         ASSERT_TRUE(fs::exists(fs::path(entry.path()).replace_extension(".exr"))) << name;
         if (name.find("__frames=") != std::string::npos) {
+            // Every reference sidecar records its criterion as met (issue 28), the sequences included. The two
+            // bumpy_sphere sequences were not regenerated with it yet (their 2026-11-26 run was cut for time):
+            // until they are, a sequence without a criterion is held to the bounds it had before; then drop that
+            // branch.
             const auto& b = m.at("error_bound");
-            EXPECT_LT(b.at("mean_flip_max").get<double>(), 0.003) << name;
-            EXPECT_LT(b.at("relative_rmse_max").get<double>(), 0.025) << name;
+            if (b.contains("criterion")) {
+                EXPECT_TRUE(b.at("criterion").at("met").get<bool>()) << name;
+                EXPECT_LT(b.at("mean_flip_ldr_max").get<double>(), b.at("criterion").at("mean_flip_ldr_below").get<double>())
+                    << name;
+            } else {
+                EXPECT_NE(name.find("bumpy_sphere__"), std::string::npos) << name << ": a sequence without a criterion";
+                EXPECT_LT(b.at("mean_flip_max").get<double>(), 0.003) << name;
+                EXPECT_LT(b.at("relative_rmse_max").get<double>(), 0.025) << name;
+            }
             ++sequences;
         } else if (m.value("integrator", "") == "quadrature") {
             EXPECT_TRUE(m.at("error_bound").at("criterion").at("met").get<bool>()) << name;
