@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 
 #include "reports/report_html.h"
+#include "reports/temporal_verdict.h"
 
 namespace iblcheck::report::html {
 
@@ -335,6 +336,7 @@ void roughness_section(std::string& o, const std::vector<const json*>& tests) {
 void flicker_section(std::string& o, const std::vector<const json*>& tests) {
     // Flicker against FLIP: one panel per environment, points named by what differs.
     o += "<h2 id=\"temporal\">Flicker against FLIP (temporal tests)</h2>\n";
+    o += aa_verdict_html(tests); // which specular_aa variant helps, from this run's truth figures
     std::map<std::string, Chart> flick;
     for (size_t i = 0; i < tests.size(); ++i) {
         const json& t = *tests[i];

@@ -4,6 +4,7 @@
 #   ci_failure_page.png          the same report, the whole page
 #   nightly_first_screen.png     a nightly run, the first screen
 #   nightly_charts.png           its Charts tab, the first 1440x1800
+#   temporal_aa_verdict.png      a temporal run's Charts tab at its specular-AA verdict (issue 28)
 # The failure is made the way a shader change makes one: a copy of the goldens in which the sky_sun
 # Lagarde baseline was blessed from a shader whose Lagarde lerp factor lacks its square root, so
 # today's shader differs from that baseline (and from no other).
@@ -11,7 +12,7 @@
 #   scripts/report_screenshots.sh [OUT_DIR]     (default reports/screenshots)
 #
 # Takes the ci suite (~30 s) and the nightly suite (~1-3 min idle, ~12 min on a loaded 2-core
-# machine). NIGHTLY_RUN=DIR reuses the results of an earlier `iblcheck run --suite nightly --out DIR`.
+# machine), and the temporal suite (~1-2 min). NIGHTLY_RUN=DIR (TEMPORAL_RUN=DIR) reuses the results of an earlier `iblcheck run --suite nightly --out DIR`.
 # Needs build/iblcheck and build/tests/report_browser (cmake --build build --target iblcheck report_browser).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -39,8 +40,15 @@ else
   "$BUILD/iblcheck" run --suite nightly --out "$tmp/nightly" -q
 fi
 
+if [[ -n "${TEMPORAL_RUN:-}" ]]; then
+  "$BUILD/iblcheck" report "$TEMPORAL_RUN/results.json" --out "$tmp/temporal"
+else
+  "$BUILD/iblcheck" run --suite temporal --out "$tmp/temporal" -q
+fi
+
 shot="$BUILD/tests/report_browser"
 "$shot" "$tmp/ci/index.html" --out "$OUT/ci_failure_first_screen.png"
 "$shot" "$tmp/ci/index.html" --out "$OUT/ci_failure_page.png" --full
 "$shot" "$tmp/nightly/index.html" --out "$OUT/nightly_first_screen.png"
 "$shot" "$tmp/nightly/index.html" --out "$OUT/nightly_charts.png" --tab charts --height 1800
+"$shot" "$tmp/temporal/index.html" --out "$OUT/temporal_aa_verdict.png" --tab charts --scroll-to aa-verdict --height 1100
