@@ -20,8 +20,8 @@
 #include "image_compare.h"
 #include "metrics/image_io.h"
 #include "provenance.h"
-#include "verdict.h"
 #include "renderers/environments/environment.h"
+#include "verdict.h"
 #include "worker.h"
 
 namespace fs = std::filesystem;

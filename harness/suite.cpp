@@ -326,7 +326,8 @@ struct TestEntry {
 TestEntry parse_test(const Ctx& c, const json& t, const std::string& w, const Suite& suite, const SuiteDefaults& d) {
     c.keys(t, w,
            {"scene", "method", "env", "size", "options", "variants", "baseline", "reference", "baseline_tolerances",
-            "reference_band", "tags", "temporal", "stability", "max_cost_growth", "tolerance_note", "measure_only", "display", "shader"});
+            "reference_band", "tags", "temporal", "stability", "max_cost_growth", "tolerance_note", "measure_only", "display",
+            "shader"});
     if (t.contains("tolerance_note")) c.str(t["tolerance_note"], w + ".tolerance_note");
     if (!t.contains("scene")) c.fail(w + ".scene", "missing required key");
     if (!t.contains("method")) c.fail(w + ".method", "missing required key");

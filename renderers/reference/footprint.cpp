@@ -66,8 +66,9 @@ namespace {
 // the shading is a smooth function of (β, ψ) up to the rim, where as a function of position it has a
 // square-root singularity (n·v = √(1 − ρ²/r²)). The ψ-range is split where the ray's entry or exit
 // changes side (the square's corners inside the disc, the circle's crossings of its edges), so that
-// each piece has smooth limits; each piece gets 5-point Gauss–Legendre in ψ × 3-point Gauss–Legendre
-// in β, dA = r² sin β cos β dβ dψ.
+// each piece has smooth limits; dA = r² sin β cos β dβ dψ. A piece between two corners gets the
+// midpoint in ψ × 2-point Gauss–Legendre in β; a piece that ends where the circle crosses an edge gets
+// 5 × 3 points (below).
 //
 // The rule must be right on a sliver by itself, because refinement cannot see its error: a square
 // whose disc part is a sliver at one corner has one child holding the same sliver, cut into the same
@@ -87,6 +88,8 @@ constexpr double kX5 = 0.9061798459386640, kY5 = 0.5384693101056831, kX3 = 0.774
 constexpr double kNode5[5] = {0.5 - 0.5 * kX5, 0.5 - 0.5 * kY5, 0.5, 0.5 + 0.5 * kY5, 0.5 + 0.5 * kX5};
 constexpr double kWeight5[5] = {0.2369268850561891 / 2, 0.4786286704993665 / 2, 0.5688888888888889 / 2, 0.4786286704993665 / 2,
                                 0.2369268850561891 / 2};
+constexpr double kNode2[2] = {0.5 - 0.5 / 1.7320508075688772, 0.5 + 0.5 / 1.7320508075688772};
+constexpr double kWeight2[2] = {0.5, 0.5};
 constexpr double kNode3[3] = {0.5 - 0.5 * kX3, 0.5, 0.5 + 0.5 * kX3};
 constexpr double kWeight3[3] = {5.0 / 18, 8.0 / 18, 5.0 / 18};
 } // namespace gauss
@@ -121,8 +124,8 @@ int polar_cuts(double r, double X0, double Y0, double X1, double Y1, double pc, 
 }
 
 // One ray ψ: ∫ g r² sin β cos β dβ over the ray's part inside the square (and the disc), times w, into e.
-int polar_ray(const Disc& d, double X0, double Y0, double X1, double Y1, double psi, double w, const PointShader& g,
-              double e[3]) {
+int polar_ray(const Disc& d, double X0, double Y0, double X1, double Y1, double psi, double w, int beta_points,
+              const PointShader& g, double e[3]) {
     const double r = d.r, ux = std::cos(psi), uy = std::sin(psi);
     double t0 = 0, t1 = r; // the ray t·u (t ≥ 0) inside the square: slab intersection
     for (auto [u, lo, hi] : {std::tuple{ux, X0, X1}, std::tuple{uy, Y0, Y1}}) {
@@ -136,17 +139,21 @@ int polar_ray(const Disc& d, double X0, double Y0, double X1, double Y1, double 
     }
     if (t1 <= t0) return 0;
     const double b0 = std::asin(std::min(1.0, t0 / r)), b1 = std::asin(std::min(1.0, t1 / r));
-    for (int ib = 0; ib < 3; ++ib) {
-        const double beta = b0 + gauss::kNode3[ib] * (b1 - b0), rho = r * std::sin(beta);
-        const double wb = w * gauss::kWeight3[ib] * (b1 - b0) * r * r * std::sin(beta) * std::cos(beta);
+    const double* node = beta_points == 3 ? gauss::kNode3 : gauss::kNode2;
+    const double* weight = beta_points == 3 ? gauss::kWeight3 : gauss::kWeight2;
+    for (int ib = 0; ib < beta_points; ++ib) {
+        const double beta = b0 + node[ib] * (b1 - b0), rho = r * std::sin(beta);
+        const double wb = w * weight[ib] * (b1 - b0) * r * r * std::sin(beta) * std::cos(beta);
         double rgb[3] = {0, 0, 0};
         g(d.cx + rho * ux, d.cy + rho * uy, rgb);
         for (int q = 0; q < 3; ++q) e[q] += wb * rgb[q];
     }
-    return 3;
+    return beta_points;
 }
 
-// ∫ over ψ ∈ [p0, p1] (5-point Gauss); at a crossing end, in u with ψ − ψc = ±(p1 − p0)·u².
+// ∫ over ψ ∈ [p0, p1]. A piece between two corners is split by the children of its square, so the
+// refinement sees its rule's error: the midpoint × 2 points in β. A piece with a crossing end may be a
+// sliver the children reproduce: 5-point Gauss in u with ψ − ψc = ±(p1 − p0)·u², × 3 points in β.
 int polar_piece(const Disc& d, double X0, double Y0, double X1, double Y1, double pc, double p0, double p1, bool cross0,
                 bool cross1, const PointShader& g, double e[3]) {
     if (cross0 && cross1) {
@@ -154,14 +161,15 @@ int polar_piece(const Disc& d, double X0, double Y0, double X1, double Y1, doubl
         return polar_piece(d, X0, Y0, X1, Y1, pc, p0, m, true, false, g, e) +
                polar_piece(d, X0, Y0, X1, Y1, pc, m, p1, false, true, g, e);
     }
-    int evals = 0;
     const double len = p1 - p0;
+    if (!cross0 && !cross1) return polar_ray(d, X0, Y0, X1, Y1, pc + p0 + 0.5 * len, len, 2, g, e);
+    int evals = 0;
     for (int ip = 0; ip < 5; ++ip) {
         const double u = gauss::kNode5[ip];
         double psi = p0 + u * len, w = gauss::kWeight5[ip] * len;
         if (cross0) psi = p0 + u * u * len, w *= 2 * u;
         if (cross1) psi = p1 - u * u * len, w *= 2 * u;
-        evals += polar_ray(d, X0, Y0, X1, Y1, pc + psi, w, g, e);
+        evals += polar_ray(d, X0, Y0, X1, Y1, pc + psi, w, 3, g, e);
     }
     return evals;
 }

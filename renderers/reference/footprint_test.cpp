@@ -85,7 +85,7 @@ TEST(Footprint, IntegralMatchesBruteForceInsideAndOnTheRim) {
         // 200x200 Gauss–Legendre product rule with the rim's square root substituted away: 1.1359990 vs the
         // grid's 1.1360006). Before the polar rule took 5 points in ψ, pixel 6,10 settled 5.7e-4 of its
         // value off at any tolerance (a corner sliver, EverySilhouettePixelMatchesAnIndependentPolarIntegral).
-        // Channel 2 (√(n·v), a stronger singularity than any BRDF's: shading is smooth in n·v) is 1.3e-5
+        // Channel 2 (√(n·v), a stronger singularity than any BRDF's: shading is smooth in n·v) is ~1e-5
         // off on the rim; channels 0 and 1 agree with the grid to its own error.
         const bool rim = pi.coverage < 1;
         for (int q = 0; q < 3; ++q) {
@@ -129,7 +129,7 @@ TEST(Footprint, EverySilhouettePixelMatchesAnIndependentPolarIntegral) {
         return sum;
     };
     FootprintParams p;
-    p.tolerance = 1e-6;
+    p.tolerance = 1e-5;
     int rim = 0, slivers = 0;
     double worst = 0;
     for (int py = 2; py < 40; ++py)
