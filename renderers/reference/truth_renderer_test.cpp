@@ -269,20 +269,12 @@ TEST(TruthRenderer, CommittedReferenceGoldensStateABoundThatHolds) {
         const std::string name = entry.path().filename().string();
         ASSERT_TRUE(fs::exists(fs::path(entry.path()).replace_extension(".exr"))) << name;
         if (name.find("__frames=") != std::string::npos) {
-            // Every reference sidecar records its criterion as met (issue 28), the sequences included. bumpy_sphere
-            // under studio was not regenerated with it yet (its 2026-11-26 run was cut for time):
-            // until it is, a sequence without a criterion is held to the bounds it had before; then drop that
-            // branch.
+            // Every reference sidecar records its criterion as met (issue 28), the sequences included: the sequence
+            // criterion is truth::sequence_criterion's (LDR-FLIP relied on, HDR-FLIP and relative RMSE bounded).
             const auto& b = m.at("error_bound");
-            if (b.contains("criterion")) {
-                EXPECT_TRUE(b.at("criterion").at("met").get<bool>()) << name;
-                EXPECT_LT(b.at("mean_flip_ldr_max").get<double>(), b.at("criterion").at("mean_flip_ldr_below").get<double>())
-                    << name;
-            } else {
-                EXPECT_NE(name.find("bumpy_sphere__studio__"), std::string::npos) << name << ": a sequence without a criterion";
-                EXPECT_LT(b.at("mean_flip_max").get<double>(), 0.003) << name;
-                EXPECT_LT(b.at("relative_rmse_max").get<double>(), 0.025) << name;
-            }
+            ASSERT_TRUE(b.contains("criterion")) << name << ": a sequence without a criterion";
+            EXPECT_TRUE(b.at("criterion").at("met").get<bool>()) << name;
+            EXPECT_LT(b.at("mean_flip_ldr_max").get<double>(), b.at("criterion").at("mean_flip_ldr_below").get<double>()) << name;
             ++sequences;
         } else if (m.value("integrator", "") == "quadrature") {
             EXPECT_TRUE(m.at("error_bound").at("criterion").at("met").get<bool>()) << name;
