@@ -18,7 +18,8 @@ namespace {
 // The run's default mobile test of that scene and environment (its image is the sweep image).
 const json* default_test(const json& results, const std::string& scene, const std::string& env) {
     for (const json& t : sub(results, "tests"))
-        if (str(t, "method") == "mobile" && str(t, "scene") == scene && str(t, "env") == env && str(t, "variant").empty())
+        if (str(t, "method") == "mobile" && str(t, "scene") == scene && str(t, "env") == env &&
+            (str(t, "variant").empty() || str(t, "variant") == "default"))
             return &t;
     return nullptr;
 }

@@ -43,7 +43,9 @@ struct Measured {
 };
 
 std::string pct(double a, double b) { return b > 0 ? fmt::format("{:+.1f} %", 100 * (a / b - 1)) : ""; }
-std::string variant_name(const json& t) { return str(t, "variant").empty() ? "default" : str(t, "variant"); }
+// A run names the default configuration's variant "default" (older results: "").
+bool is_default(const json& t) { return str(t, "variant").empty() || str(t, "variant") == "default"; }
+std::string variant_name(const json& t) { return is_default(t) ? "default" : str(t, "variant"); }
 
 // The run's tests with an accuracy against the truth, by "method scene env".
 std::map<std::string, std::vector<Measured>> measured_groups(const json& results) {
@@ -59,7 +61,7 @@ std::map<std::string, std::vector<Measured>> measured_groups(const json& results
 
 const Measured* default_of(const std::vector<Measured>& ms) {
     for (const Measured& m : ms)
-        if (str(*m.t, "variant").empty()) return &m;
+        if (is_default(*m.t)) return &m;
     return nullptr;
 }
 
