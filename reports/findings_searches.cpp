@@ -1,5 +1,6 @@
 // The findings' parts read from `iblcheck explain --json` and `iblcheck explore --json` files
 // (nightly_findings.h): the largest share of error with the stacked bars, and the Pareto fronts.
+#include <algorithm>
 #include <cmath>
 #include <map>
 
@@ -40,10 +41,21 @@ std::string budget_block(const json& b, const json& results, ImageStore& images,
         words.push_back(line);
         o += "<p>" + line + "</p>\n";
     }
-    if (const json* t = default_test(results, scene, env))
+    // The sweep image at its own size, the bars under it column for column (columns: the most
+    // spheres of one material).
+    double pitch = 30;
+    if (const json* t = default_test(results, scene, env)) {
+        const double width = num(*t, "width").value_or(0);
+        std::map<double, int> per_material;
+        int cols = 1;
+        for (const json& s : b["total"]["spheres"]) cols = std::max(cols, ++per_material[s.value("metallic", 0.0)]);
+        if (width > 0) pitch = width / cols;
         if (auto url = images.url(str(*t, "image")))
-            o += fmt::format("<img class=\"sweep\" src=\"{}\" alt=\"{}\">\n", e(*url), e(str(*t, "name")));
-    return o + budget_bars_svg(b) + "</div>\n";
+            o +=
+                fmt::format("<img class=\"sweep\" src=\"{}\" alt=\"{}\" style=\"display:block;width:{:.0f}px;max-width:none\">\n",
+                            e(*url), e(str(*t, "name")), width > 0 ? width : 528.0);
+    }
+    return o + budget_bars_svg(b, pitch) + "</div>\n";
 }
 
 std::string front_table(const json& env) {

@@ -37,7 +37,9 @@ std::string findings_html(const nlohmann::json& results, const std::vector<nlohm
 // the sphere's mean FLIP, a colour per rung, positive shares stacked up from zero and negative ones
 // down; <svg class="chart budget" data-chart="budget-ENV" data-points="SPHERES">, a <rect
 // class="seg" data-rung="KEY"> per non-zero share.
-std::string budget_bars_svg(const nlohmann::json& budget);
+// The bars are laid out as the sweep image lays out the spheres: a row per material (metallic value),
+// `pitch` pixels a column (the image's width over its columns), so each bar stands under its sphere.
+std::string budget_bars_svg(const nlohmann::json& budget, double pitch = 30);
 
 // The section's parts read from the findings files (findings_searches.cpp); each adds its sentences
 // to `words`.

@@ -30,57 +30,82 @@ double share_of(const json& rung, size_t sphere) {
     return sphere < s.size() ? s[sphere].value("flip", 0.0) : 0.0;
 }
 
+// The spheres' rows: one per material (metallic value) in order of appearance, as the sweep image
+// lays them out (metals above, dielectrics below), so each bar stands under its sphere's column.
+std::vector<std::vector<size_t>> sphere_rows(const json& spheres) {
+    std::vector<double> keys;
+    std::vector<std::vector<size_t>> rows;
+    for (size_t i = 0; i < spheres.size(); ++i) {
+        const double m = spheres[i].value("metallic", 0.0);
+        const size_t k = size_t(std::find(keys.begin(), keys.end(), m) - keys.begin());
+        if (k == keys.size()) keys.push_back(m), rows.emplace_back();
+        rows[k].push_back(i);
+    }
+    return rows;
+}
+
+// One sphere's stack: positive shares up from zero, negative ones down, in rung order.
+std::string sphere_stack(const json& rungs, const json& sphere, size_t i, double x, double bar_w, double zero_y, double scale) {
+    std::string o;
+    double up = 0, down = 0;
+    for (const json& r : rungs) {
+        const double s = share_of(r, i);
+        if (s == 0) continue;
+        const double from = s > 0 ? up : down, to = from + s;
+        (s > 0 ? up : down) = to;
+        const std::string key = r.value("key", "");
+        o += fmt::format(
+            "<rect class=\"seg\" data-rung=\"{}\" x=\"{:.1f}\" y=\"{:.2f}\" width=\"{:.0f}\" height=\"{:.2f}\" fill=\"{}\">"
+            "<title>{}: {}: {:+.4f}</title></rect>\n",
+            html_escape(key), x, zero_y - std::max(from, to) * scale, bar_w, std::max(std::fabs(s) * scale, 0.5), rung_color(key),
+            html_escape(sphere.value("label", "")), html_escape(r.value("label", key)), s);
+    }
+    return o;
+}
+
 } // namespace
 
-std::string budget_bars_svg(const json& budget) {
+std::string budget_bars_svg(const json& budget, double pitch) {
     const json& rungs = budget["rungs"];
     const json& spheres = budget["total"]["spheres"];
-    const size_t n = spheres.size();
-    // The scale: the tallest positive stack and the deepest negative one.
+    const auto rows = sphere_rows(spheres);
+    // One scale for every bar: the tallest positive stack and the deepest negative one.
     double top = 0, bottom = 0;
-    for (size_t i = 0; i < n; ++i) {
+    for (size_t i = 0; i < spheres.size(); ++i) {
         double up = 0, down = 0;
         for (const json& r : rungs) (share_of(r, i) > 0 ? up : down) += share_of(r, i);
         top = std::max(top, up), bottom = std::min(bottom, down);
     }
     if (top <= 0) top = 1e-6;
-    const double bar_w = 22, gap = 8, left = 44, plot_h = 150, legend_h = 18 * double((rungs.size() + 3) / 4);
-    const double width = std::max(left + double(n) * (bar_w + gap) + 10, 560.0);
-    const double scale = plot_h / (top - bottom), zero_y = 20 + top * scale, height = 20 + plot_h + 56 + legend_h;
-    std::string o =
-        fmt::format("<svg class=\"chart budget\" data-chart=\"budget-{}\" data-points=\"{}\" width=\"{:.0f}\" height=\"{:.0f}\" "
-                    "viewBox=\"0 0 {:.0f} {:.0f}\" role=\"img\"><title>mean FLIP share per sphere and rung: {}</title>\n",
-                    html_escape(budget.value("env", "")), n, width, height, width, height, html_escape(budget.value("env", "")));
-    std::vector<double> ticks{top, 0.0};
-    if (bottom < 0) ticks.push_back(bottom);
-    for (double v : ticks) {
-        const double y = zero_y - v * scale;
-        o += fmt::format(
-            "<line x1=\"{:.1f}\" x2=\"{:.1f}\" y1=\"{:.1f}\" y2=\"{:.1f}\" stroke=\"#ced4da\"/><text x=\"{:.1f}\" y=\"{:.1f}\" "
-            "font-size=\"10\" text-anchor=\"end\">{}</text>\n",
-            left - 4, width - 6, y, y, left - 6, y + 3, fmt_num(v));
-    }
-    for (size_t i = 0; i < n; ++i) {
-        const double x = left + double(i) * (bar_w + gap);
-        double up = 0, down = 0;
-        for (const json& r : rungs) {
-            const double s = share_of(r, i);
-            if (s == 0) continue;
-            const double from = s > 0 ? up : down, to = from + s;
-            (s > 0 ? up : down) = to;
-            const double y0 = zero_y - std::max(from, to) * scale, h = std::fabs(s) * scale;
-            const std::string key = r.value("key", "");
-            o += fmt::format(
-                "<rect class=\"seg\" data-rung=\"{}\" x=\"{:.1f}\" y=\"{:.2f}\" width=\"{:.0f}\" height=\"{:.2f}\" fill=\"{}\">"
-                "<title>{}: {}: {:+.4f}</title></rect>\n",
-                html_escape(key), x, y0, bar_w, std::max(h, 0.5), rung_color(key), html_escape(spheres[i].value("label", "")),
-                html_escape(r.value("label", key)), s);
+    size_t cols = 1;
+    for (const auto& r : rows) cols = std::max(cols, r.size());
+    const double plot_h = 100, row_h = plot_h + 30, bar_w = std::max(4.0, pitch * 0.6), scale = plot_h / (top - bottom);
+    const double width = std::max(double(cols) * pitch + 60, 560.0), legend_y = double(rows.size()) * row_h + 14;
+    const double height = legend_y + 18 * double((rungs.size() + 3) / 4);
+    const std::string env = html_escape(budget.value("env", ""));
+    std::string o = fmt::format(
+        "<svg class=\"chart budget\" data-chart=\"budget-{0}\" data-points=\"{1}\" width=\"{2:.0f}\" height=\"{3:.0f}\" "
+        "viewBox=\"0 0 {2:.0f} {3:.0f}\" role=\"img\"><title>mean FLIP share per sphere and rung: {0}</title>\n",
+        env, spheres.size(), width, height);
+    for (size_t row = 0; row < rows.size(); ++row) {
+        const double zero_y = double(row) * row_h + 6 + top * scale, right = double(cols) * pitch;
+        std::vector<double> ticks{top, 0.0};
+        if (bottom < 0) ticks.push_back(bottom);
+        for (double v : ticks)
+            o += fmt::format("<line x1=\"0\" x2=\"{0:.1f}\" y1=\"{1:.1f}\" y2=\"{1:.1f}\" stroke=\"#ced4da\"/><text "
+                             "x=\"{2:.1f}\" y=\"{3:.1f}\" "
+                             "font-size=\"10\">{4}</text>\n",
+                             right, zero_y - v * scale, right + 4, zero_y - v * scale + 3, fmt_num(v));
+        for (size_t c = 0; c < rows[row].size(); ++c) {
+            const size_t i = rows[row][c];
+            const double x = double(c) * pitch + (pitch - bar_w) / 2;
+            o += sphere_stack(rungs, spheres[i], i, x, bar_w, zero_y, scale);
+            o += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" font-size=\"9\" text-anchor=\"middle\">{}</text>\n", x + bar_w / 2,
+                             double(row) * row_h + plot_h + 20, html_escape(spheres[i].value("label", "")));
         }
-        o += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" font-size=\"9\" transform=\"rotate(45 {:.1f} {:.1f})\">{}</text>\n",
-                         x + 4, 20 + plot_h + 10, x + 4, 20 + plot_h + 10, html_escape(spheres[i].value("label", "")));
     }
     for (size_t k = 0; k < rungs.size(); ++k) {
-        const double x = 10 + double(k % 4) * 140, y = 20 + plot_h + 62 + 18 * double(k / 4);
+        const double x = double(k % 4) * 140, y = legend_y + 18 * double(k / 4);
         const std::string key = rungs[k].value("key", "");
         o +=
             fmt::format("<rect x=\"{:.0f}\" y=\"{:.0f}\" width=\"10\" height=\"10\" fill=\"{}\"/><text x=\"{:.0f}\" y=\"{:.0f}\" "

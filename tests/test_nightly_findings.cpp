@@ -99,10 +99,19 @@ TEST(NightlyFindings, StackedBarsHaveASegmentPerNonZeroShareSignedAboutZero) {
     size_t segs = 0;
     for (size_t p = 0; (p = svg.find("class=\"seg\"", p)) != std::string::npos; ++p) ++segs;
     EXPECT_EQ(segs, 5u); // 3 shares on r=0, 2 non-zero on r=1
-    // Scale: top 0.30 (r=1's positive stack), bottom -0.01: 150 px over 0.31. The r=1 split_sum
-    // segment is 0.30 * 150 / 0.31 = 145.16 px tall; env_brdf_approx's -0.01 is 4.84 px below zero.
-    EXPECT_NE(svg.find("height=\"145.16\" fill=\"#1c7ed6\"><title>metal r=1"), std::string::npos) << svg;
-    EXPECT_NE(svg.find("height=\"4.84\" fill=\"#f59f00\"><title>metal r=1"), std::string::npos) << svg;
+    // Scale: top 0.30 (r=1's positive stack), bottom -0.01: 100 px over 0.31. The r=1 split_sum
+    // segment is 0.30 * 100 / 0.31 = 96.77 px tall; env_brdf_approx's -0.01 is 3.23 px below zero.
+    EXPECT_NE(svg.find("height=\"96.77\" fill=\"#1c7ed6\"><title>metal r=1"), std::string::npos) << svg;
+    EXPECT_NE(svg.find("height=\"3.23\" fill=\"#f59f00\"><title>metal r=1"), std::string::npos) << svg;
+    // One material: one row, the second sphere one pitch (30) to the right of the first, bars 18 wide.
+    EXPECT_NE(svg.find("x=\"6.0\" y=\"70.52\" width=\"18\" height=\"32.26\" fill=\"#1c7ed6\"><title>metal r=0"), std::string::npos)
+        << svg;
+    EXPECT_NE(svg.find("x=\"36.0\" y=\"6.00\" width=\"18\" height=\"96.77\""), std::string::npos) << svg;
+    // Two materials: two rows, both starting at the left edge, the second 130 px lower.
+    json two = budget();
+    two["total"]["spheres"][1]["metallic"] = 1.0;
+    const std::string rows = budget_bars_svg(two, 48);
+    EXPECT_NE(rows.find("x=\"9.6\" y=\"136.00\" width=\"29\" height=\"96.77\""), std::string::npos) << rows;
 }
 
 TEST(NightlyFindings, SinceTheLastRunCountsMovesBeyondTheNoiseFloorAndCostChanges) {
