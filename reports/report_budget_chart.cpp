@@ -44,6 +44,12 @@ std::vector<std::vector<size_t>> sphere_rows(const json& spheres) {
     return rows;
 }
 
+// Under a bar: its roughness (the row is one material; the full label is in the tooltip).
+std::string column_label(const json& sphere) {
+    if (sphere.contains("roughness") && sphere["roughness"].is_number()) return "r=" + fmt_num(sphere["roughness"].get<double>());
+    return sphere.value("label", "");
+}
+
 // One sphere's stack: positive shares up from zero, negative ones down, in rung order.
 std::string sphere_stack(const json& rungs, const json& sphere, size_t i, double x, double bar_w, double zero_y, double scale) {
     std::string o;
@@ -101,7 +107,7 @@ std::string budget_bars_svg(const json& budget, double pitch) {
             const double x = double(c) * pitch + (pitch - bar_w) / 2;
             o += sphere_stack(rungs, spheres[i], i, x, bar_w, zero_y, scale);
             o += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" font-size=\"9\" text-anchor=\"middle\">{}</text>\n", x + bar_w / 2,
-                             double(row) * row_h + plot_h + 20, html_escape(spheres[i].value("label", "")));
+                             double(row) * row_h + plot_h + 20, html_escape(column_label(spheres[i])));
         }
     }
     for (size_t k = 0; k < rungs.size(); ++k) {
