@@ -104,7 +104,8 @@ TEST(NightlyFindings, StackedBarsHaveASegmentPerNonZeroShareSignedAboutZero) {
     EXPECT_NE(svg.find("height=\"96.77\" fill=\"#1c7ed6\"><title>metal r=1"), std::string::npos) << svg;
     EXPECT_NE(svg.find("height=\"3.23\" fill=\"#f59f00\"><title>metal r=1"), std::string::npos) << svg;
     // One material: one row, the second sphere one pitch (30) to the right of the first, bars 18 wide.
-    EXPECT_NE(svg.find("x=\"6.0\" y=\"70.52\" width=\"18\" height=\"32.26\" fill=\"#1c7ed6\"><title>metal r=0"), std::string::npos)
+    EXPECT_NE(svg.find("x=\"6.0\" y=\"70.52\" width=\"18\" height=\"32.26\" fill=\"#1c7ed6\"><title>metal r=0"),
+              std::string::npos)
         << svg;
     EXPECT_NE(svg.find("x=\"36.0\" y=\"6.00\" width=\"18\" height=\"96.77\""), std::string::npos) << svg;
     // Two materials: two rows, both starting at the left edge, the second 130 px lower.
@@ -165,6 +166,24 @@ TEST(NightlyFindings, TheNightlyPageHasTheFindingsAtTheTopAndCiHasNone) {
     ASSERT_NE(findings, std::string::npos);
     EXPECT_LT(page.find("</header>"), findings);
     EXPECT_LT(findings, tabs);
+}
+
+// The command line: `iblcheck report --findings` puts an explain budget on a ci run's page; a file
+// that is neither explain's nor explore's is exit 2 naming it, and no page is written.
+TEST(NightlyFindings, ReportFindingsFlagReadsTheFileOrNamesItInAnExit2) {
+    const auto dir = testutil::temp_dir("findings_cli");
+    testutil::make_ci_run(dir / "run", 2, false);
+    testutil::write_file(dir / "b.json", budget().dump());
+    testutil::write_file(dir / "bad.json", R"({"suite": "ci"})");
+    const std::string cli =
+        std::string(IBLCHECK_BINARY_DIR) + "/iblcheck report " + (dir / "run" / "results.json").string() + " --out ";
+    std::string out;
+    ASSERT_EQ(testutil::run_command(cli + (dir / "ok").string() + " --findings " + (dir / "b.json").string(), out), 0) << out;
+    EXPECT_NE(testutil::read_text(dir / "ok" / "index.html").find("Under studio, the largest share of error is split sum"),
+              std::string::npos);
+    EXPECT_EQ(testutil::run_command(cli + (dir / "bad").string() + " --findings " + (dir / "bad.json").string(), out), 2) << out;
+    EXPECT_NE(out.find((dir / "bad.json").string() + ": neither an `iblcheck explain --json` budget"), std::string::npos) << out;
+    EXPECT_FALSE(std::filesystem::exists(dir / "bad" / "index.html"));
 }
 
 } // namespace
