@@ -87,7 +87,8 @@ std::string budget_bars_svg(const json& budget, double pitch) {
     for (const auto& r : rows) cols = std::max(cols, r.size());
     const double plot_h = 100, row_h = plot_h + 30, bar_w = std::max(4.0, pitch * 0.6), scale = plot_h / (top - bottom);
     const double width = std::max(double(cols) * pitch + 60, 560.0), legend_y = double(rows.size()) * row_h + 14;
-    const double height = legend_y + 18 * double((rungs.size() + 3) / 4);
+    const size_t legend_rows = (rungs.size() + 3) / 4; // four rungs a legend row
+    const double height = legend_y + 18 * double(legend_rows);
     const std::string env = html_escape(budget.value("env", ""));
     std::string o = fmt::format(
         "<svg class=\"chart budget\" data-chart=\"budget-{0}\" data-points=\"{1}\" width=\"{2:.0f}\" height=\"{3:.0f}\" "
@@ -111,7 +112,8 @@ std::string budget_bars_svg(const json& budget, double pitch) {
         }
     }
     for (size_t k = 0; k < rungs.size(); ++k) {
-        const double x = double(k % 4) * 140, y = legend_y + 18 * double(k / 4);
+        const size_t legend_row = k / 4;
+        const double x = double(k % 4) * 140, y = legend_y + 18 * double(legend_row);
         const std::string key = rungs[k].value("key", "");
         o +=
             fmt::format("<rect x=\"{:.0f}\" y=\"{:.0f}\" width=\"10\" height=\"10\" fill=\"{}\"/><text x=\"{:.0f}\" y=\"{:.0f}\" "
