@@ -114,7 +114,7 @@ void write_outputs(const json& R, const RunOptions& o, RunFolder& folder) {
     if (!o.junit.empty()) write_junit(R, o.junit);
     std::vector<json> history;
     if (!o.history.empty()) history = append_history(o.history, history_entry(R));
-    if (!dir.empty() && o.report) write_report(R, dir, dir, history);
+    if (!dir.empty() && o.report) write_report(R, dir, dir, history, o.findings);
     folder.commit();
 }
 

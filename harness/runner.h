@@ -35,6 +35,8 @@ struct RunOptions {
     bool force = false;     // replace an earlier run's --out, overwrite --json and --junit files
     bool report = true;     // write index.html when out_dir is set
     bool stability = false; // measure determinism, noise floors and margins for every test
+    // --findings: `iblcheck explain/explore --json` files for the report's findings (nightly_findings.h)
+    std::vector<nlohmann::json> findings;
 };
 
 struct RunSummary {

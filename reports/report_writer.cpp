@@ -18,6 +18,7 @@
 #include "metrics/flip/magma_table.h"
 #include "metrics/flip/tone_mappers.h"
 #include "reports/drift.h"
+#include "reports/nightly_findings.h"
 #include "reports/report_assets.h"
 #include "reports/report_html.h"
 #include "reports/report_script.h"
@@ -369,7 +370,8 @@ void write_atomically(const fs::path& out_dir, const std::string& o) {
 
 } // namespace
 
-void write_report(const json& results, const fs::path& results_dir, const fs::path& out_dir, const std::vector<json>& history) {
+void write_report(const json& results, const fs::path& results_dir, const fs::path& out_dir, const std::vector<json>& history,
+                  const std::vector<json>& findings) {
     validate_results(results, (results_dir / "results.json").string());
     std::error_code ec;
     fs::create_directories(out_dir, ec);
@@ -391,6 +393,7 @@ void write_report(const json& results, const fs::path& results_dir, const fs::pa
     o.reserve(1 << 18);
     page_head(o, str(results, "suite"), counts);
     summary_section(o, results, tests, counts, bad);
+    if (findings_wanted(results, findings)) o += findings_html(results, history, findings, store);
     tabs_nav(o, tests.size());
     tests_tab(o, tests, ctx, trends);
     o += "<section class=\"tab\" id=\"tab-charts\">\n" + charts_html(tests) + "</section>\n";

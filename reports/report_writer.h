@@ -23,8 +23,9 @@ namespace iblcheck::report {
 // read_history (oldest first); the current run is added to the trend unless it is already the
 // last entry. Throws InputError naming results_dir/results.json and the problem when `results`
 // does not follow the schema; Error when out_dir cannot be written.
+// `findings`: explain/explore JSON files for the findings at the top (nightly_findings.h).
 void write_report(const nlohmann::json& results, const std::filesystem::path& results_dir, const std::filesystem::path& out_dir,
-                  const std::vector<nlohmann::json>& history = {});
+                  const std::vector<nlohmann::json>& history = {}, const std::vector<nlohmann::json>& findings = {});
 
 // Reads and validates a results file (InputError naming the file: unreadable, not JSON, schema).
 nlohmann::json read_results(const std::filesystem::path& results_file);

@@ -12,6 +12,7 @@ void register_run_commands(CLI::App& app, int& exit_code); // run, bless, bisect
 void register_report_command(CLI::App& app, int& exit_code);
 void register_truth_command(CLI::App& app, int& exit_code);   // truth_command.cpp
 void register_explain_command(CLI::App& app, int& exit_code); // explain_command.cpp
+void register_explore_command(CLI::App& app, int& exit_code); // explore_command.cpp
 
 // The command line as typed, recorded in results JSON.
 void set_invocation(const std::string& command_line);

@@ -26,6 +26,7 @@ int main(int argc, char** argv) {
     // The printed bless and truth commands name this binary as the user reaches it (program.h).
     iblcheck::set_program_name(iblcheck::program_from_self());
     iblcheck::cli::register_explain_command(app, exit_code);
+    iblcheck::cli::register_explore_command(app, exit_code);
     {
         std::string line = iblcheck::program_name();
         for (int i = 1; i < argc; ++i) line += " " + iblcheck::shell_arg(argv[i]); // the report's Copy button pastes it

@@ -9,6 +9,7 @@
 #include "harness/common/output_files.h"
 #include "harness/junit.h"
 #include "reports/merge_shards.h"
+#include "reports/nightly_findings.h"
 #include "reports/report_writer.h"
 
 namespace iblcheck::cli {
@@ -57,6 +58,7 @@ void register_report_command(CLI::App& app, int& exit_code) {
     struct Args {
         std::vector<std::string> results;
         std::string out, history, junit;
+        std::vector<std::string> findings;
         bool force = false;
     };
     auto args = std::make_shared<Args>();
@@ -69,6 +71,8 @@ void register_report_command(CLI::App& app, int& exit_code) {
     cmd->add_option("--out", args->out, "folder for index.html and the images it shows")->required();
     cmd->add_option("--junit", args->junit, "also write JUnit XML of the (merged) results");
     cmd->add_option("--history", args->history, "history file (JSON lines, one entry per run) for trend lines");
+    cmd->add_option("--findings", args->findings,
+                    "an `iblcheck explain/explore --json` file for the findings at the top (repeatable)");
     cmd->add_flag("--force", args->force,
                   "write into an --out folder that holds files (index.html and images are overwritten), and over --junit");
     cmd->callback([args, &exit_code] {
@@ -78,10 +82,11 @@ void register_report_command(CLI::App& app, int& exit_code) {
         const bool merge = args->results.size() > 1;
         const nlohmann::json results =
             merge ? merge_into(args->results, args->out) : report::read_results(fs::path(args->results[0]));
-        std::vector<nlohmann::json> history;
+        std::vector<nlohmann::json> history, findings;
         if (!args->history.empty()) history = report::read_history(args->history);
+        for (const std::string& f : args->findings) findings.push_back(report::read_findings(f));
         const fs::path dir = merge ? fs::path(args->out) : folder_of(args->results[0]);
-        report::write_report(results, dir, args->out, history);
+        report::write_report(results, dir, args->out, history, findings);
         if (!args->junit.empty()) write_junit(results, args->junit);
         fmt::print("report: {}{}\n", (fs::path(args->out) / "index.html").string(),
                    merge ? fmt::format(" ({} shards merged: {} tests)", args->results.size(), results["tests"].size()) : "");

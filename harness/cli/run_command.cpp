@@ -5,6 +5,7 @@
 #include "harness/common/errors.h"
 #include "harness/runner.h"
 #include "harness/suite.h"
+#include "reports/nightly_findings.h"
 
 namespace iblcheck::cli {
 
@@ -44,6 +45,7 @@ void repeat_runs(const RunOptions& run, RunSummary& first, int repeat, int& exit
 void register_run(CLI::App& app, int& exit_code) {
     static RunOptions run;
     static std::string shard, out, junit, json_out, history, goldens;
+    static std::vector<std::string> findings;
     auto* r = app.add_subcommand("run", "Run a suite: render, compare with goldens, verdicts, report");
     r->add_option("--suite", run.suite, "Suite name (harness/suites) or a .json path")->capture_default_str();
     r->add_option("--filter", run.filter, "Glob on test names");
@@ -55,6 +57,7 @@ void register_run(CLI::App& app, int& exit_code) {
     r->add_option("--json", json_out, "Results JSON file");
     r->add_option("--history", history, "Append this run to a history file (JSON lines) and chart it");
     r->add_option("--goldens", goldens, "Golden folder (default: goldens/)");
+    r->add_option("--findings", findings, "An `iblcheck explain/explore --json` file for the report's findings (repeatable)");
     r->add_option("--device", run.device, "Vulkan device/driver name substring (default: lavapipe)");
     r->add_flag("--quiet,-q", run.quiet, "No per-test lines (the summary line stays)");
     r->add_flag("--force", run.force,
@@ -73,6 +76,7 @@ void register_run(CLI::App& app, int& exit_code) {
         run.junit = junit;
         run.json = json_out;
         run.history = history;
+        for (const std::string& f : findings) run.findings.push_back(report::read_findings(f));
         run.goldens = goldens;
         run.command_line = invocation();
         if (list_only) {
