@@ -5,6 +5,7 @@
 #   nightly_first_screen.png     a nightly run, the first screen
 #   nightly_charts.png           its Charts tab, the first 1440x1800
 #   temporal_aa_verdict.png      a temporal run's Charts tab at its specular-AA verdict (issue 28)
+#   temporal_aa_sweep.png        the same for a specular_aa_sweep.py run, when SWEEP_RUN=DIR names its output
 # The failure is made the way a shader change makes one: a copy of the goldens in which the sky_sun
 # Lagarde baseline was blessed from a shader whose Lagarde lerp factor lacks its square root, so
 # today's shader differs from that baseline (and from no other).
@@ -51,4 +52,8 @@ shot="$BUILD/tests/report_browser"
 "$shot" "$tmp/ci/index.html" --out "$OUT/ci_failure_page.png" --full
 "$shot" "$tmp/nightly/index.html" --out "$OUT/nightly_first_screen.png"
 "$shot" "$tmp/nightly/index.html" --out "$OUT/nightly_charts.png" --tab charts --height 1800
-"$shot" "$tmp/temporal/index.html" --out "$OUT/temporal_aa_verdict.png" --tab charts --scroll-to aa-verdict --height 1100
+"$shot" "$tmp/temporal/index.html" --out "$OUT/temporal_aa_verdict.png" --tab charts --scroll-to aa-verdict --height 1300
+if [[ -n "${SWEEP_RUN:-}" ]]; then
+  "$BUILD/iblcheck" report "$SWEEP_RUN/results.json" --out "$tmp/sweep"
+  "$shot" "$tmp/sweep/index.html" --out "$OUT/temporal_aa_sweep.png" --tab charts --scroll-to aa-verdict --height 1500
+fi
