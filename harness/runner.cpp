@@ -45,6 +45,7 @@ PoolOutcome run_tests(const std::vector<TestCase>& tests, const RunOptions& o, c
     std::mutex print_mutex, driver_mutex;
     json driver;
     const bool interactive = isatty(STDOUT_FILENO);
+    ConsoleBudget budget;
     std::exception_ptr failure; // what stopped a worker (no device), rethrown after the join
     auto work = [&] {
         try {
@@ -58,7 +59,7 @@ PoolOutcome run_tests(const std::vector<TestCase>& tests, const RunOptions& o, c
                 int n = ++done;
                 if (!o.quiet) {
                     std::lock_guard lock(print_mutex);
-                    print_test_line(results[i], n, tests.size(), interactive);
+                    print_test_line(results[i], n, tests.size(), interactive, budget);
                 }
             }
             std::lock_guard lock(driver_mutex);

@@ -1,5 +1,7 @@
 #include "suite.h"
 
+#include "harness/common/name_filter.h"
+
 #include <fnmatch.h>
 
 #include <fmt/core.h>
@@ -222,20 +224,7 @@ std::vector<std::string> suite_names() {
 // Several globs separated by '|' match a name when one of them does (the "approve all failures"
 // line names each failing test). A '|' after a backslash is part of its glob: a test name (an
 // environment file's name) may hold one, and glob_escape writes it so.
-bool glob_match(const std::string& pattern, const std::string& name) {
-    if (pattern.empty()) return true;
-    std::string one;
-    for (size_t i = 0; i <= pattern.size(); ++i) {
-        if (i == pattern.size() || pattern[i] == '|') {
-            if (fnmatch(one.c_str(), name.c_str(), 0) == 0) return true;
-            one.clear();
-            continue;
-        }
-        one += pattern[i];
-        if (pattern[i] == '\\' && i + 1 < pattern.size()) one += pattern[++i];
-    }
-    return false;
-}
+bool glob_match(const std::string& pattern, const std::string& name) { return name_filter_match(pattern, name); }
 
 namespace {
 

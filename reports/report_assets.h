@@ -109,6 +109,10 @@ svg.spark line.moved{stroke:#e03131;stroke-dasharray:2 2}svg.spark text.moved{fo
 .charts{display:flex;flex-wrap:wrap}
 footer{color:var(--mut);font-size:12px;margin-top:20px}
 [hidden]{display:none!important}
+section.group{border-left:4px solid var(--fail);padding-left:10px;margin:8px 0 16px}
+h2.ghead{font-size:15px;margin:4px 0}
+details.gmore>summary{cursor:pointer;color:var(--mut);font-size:13px;margin:6px 0}
+table.since td.info{color:var(--mut)}
 )CSS";
 
 } // namespace iblcheck::report::assets

@@ -11,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "reports/failure_groups.h"
 #include "reports/float_data.h"
 #include "reports/svg_chart.h"
 
@@ -87,6 +88,11 @@ void viewer_html(std::string& o, PageContext& ctx, const json& t, const ViewerSp
 // A test's full card (<section class="test ...">): expanded for what needs a look, folded (hidden,
 // opened from its tile) for a pass.
 void test_card(std::string& o, const json& t, size_t idx, PageContext& ctx, const Trend& trend, bool expanded);
+// Failures that share a cause (failure_groups.h), group `k` (report_groups.cpp): what they share,
+// the group's one approve command, the representative's card expanded, the others' tiles folded in a
+// <details> (each opens its card).
+void group_section(std::string& o, const std::vector<const json*>& tests, const FailureGroup& g, size_t k,
+                   const std::string& bless_line, PageContext& ctx, const std::vector<Trend>& trends);
 // A passing test's thumbnail tile in the grid; clicking it opens the card.
 void test_tile(std::string& o, const json& t, size_t idx, PageContext& ctx);
 

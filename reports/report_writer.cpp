@@ -18,6 +18,7 @@
 #include "metrics/flip/magma_table.h"
 #include "metrics/flip/tone_mappers.h"
 #include "reports/drift.h"
+#include "reports/failure_groups.h"
 #include "reports/report_assets.h"
 #include "reports/report_html.h"
 #include "reports/report_script.h"
@@ -201,7 +202,8 @@ void summary_section(std::string& o, const json& results, const std::vector<cons
                        e(str(results, "command")));
     json arr = json::array();
     for (const json* t : tests) arr.push_back(*t);
-    const std::string all_line = rebless_all_line(arr, bless_argument(tests, "--suite "), bless_argument(tests, "--shader "));
+    const std::string all_line =
+        rebless_all_line(arr, bless_argument(tests, "--suite "), bless_argument(tests, "--shader "), ran_whole_suite(results));
     const size_t colon = all_line.find("): ") == std::string::npos ? std::string::npos : all_line.find("): ") + 1;
     if (colon != std::string::npos)
         fmt::format_to(out,
@@ -254,14 +256,15 @@ void failure_modes(std::string& o, const std::vector<const json*>& tests) {
 }
 
 // Tests: failures expanded, then the grid of passing tests, then the failure modes.
-void tests_tab(std::string& o, const std::vector<const json*>& tests, PageContext& ctx, const std::vector<Trend>& trends) {
+void tests_tab(std::string& o, const std::vector<const json*>& tests, const std::vector<FailureGroup>& groups, PageContext& ctx,
+               const std::vector<Trend>& trends) {
     o += "<section class=\"tab\" id=\"tab-tests\">\n";
     size_t n_open = 0;
-    for (size_t i = 0; i < tests.size(); ++i)
-        if (str(*tests[i], "verdict") != "pass") {
-            test_card(o, *tests[i], i, ctx, trends[i], true);
-            ++n_open;
-        }
+    const std::string suite_arg = bless_argument(tests, "--suite "), shader_arg = bless_argument(tests, "--shader ");
+    for (size_t k = 0; k < groups.size(); ++k) {
+        group_section(o, tests, groups[k], k, group_bless_line(tests, groups[k], suite_arg, shader_arg), ctx, trends);
+        n_open += groups[k].members.size();
+    }
     if (n_open < tests.size()) {
         fmt::format_to(std::back_inserter(o),
                        "<h2 id=\"passing\">{} passing test{} <span class=\"meta\">click a tile to open it</span></h2>\n"
@@ -384,6 +387,7 @@ void write_report(const json& results, const fs::path& results_dir, const fs::pa
     const bool bad = counts["fail"] + counts["error"] + counts["missing-golden"] > 0;
     const json current = history_entry(results);
     const History hist = history_window(history, current);
+    const std::vector<FailureGroup> groups = group_failures(tests, ran_whole_suite(results));
     std::vector<Trend> trends;
     for (const json* t : tests) trends.push_back(trend_for(hist, str(*t, "name")));
 
@@ -392,7 +396,7 @@ void write_report(const json& results, const fs::path& results_dir, const fs::pa
     page_head(o, str(results, "suite"), counts);
     summary_section(o, results, tests, counts, bad);
     tabs_nav(o, tests.size());
-    tests_tab(o, tests, ctx, trends);
+    tests_tab(o, tests, groups, ctx, trends);
     o += "<section class=\"tab\" id=\"tab-charts\">\n" + charts_html(tests) + "</section>\n";
     history_tab(o, tests, hist, trends);
     table_tab(o, tests);

@@ -198,3 +198,53 @@ TEST(ReportBrowser, CiReportWithOneFailureReadsInTheFirstScreenAndItsViewerWorks
     }
     fs::remove_all(dir);
 }
+
+// A change that fails 45 tests the same way (issue 32; one mip constant did so to the ci suite): the
+// first screen shows the group, its representative's image in the viewer and one short approve
+// command; the 44 others are folded, each opens its card; the page stays a few screens.
+TEST(ReportBrowser, CiReportWith45FailuresOfOneCauseShowsOneGroupInTheFirstScreen) {
+    if (!Browser::available()) GTEST_SKIP() << Browser::kChromium << " is not installed (Debian package chromium)";
+    const fs::path dir = testutil::temp_dir("browser_ci45");
+    const testutil::CiRun run = testutil::make_ci_run(dir / "run", 26, 45);
+    report::write_report(run.results, run.dir, run.dir);
+    {
+        Browser b(dir / "profile", 1440, 900);
+        b.open("file://" + (run.dir / "index.html").string(), kReady, 60);
+        expect_loaded(b);
+        const int height = b.eval("document.documentElement.scrollHeight").get<int>();
+        std::cout << "ci report (26 pass, 45 fail) at 1440x900: " << height << " px\n";
+        EXPECT_LT(height, 6000);
+        EXPECT_EQ(b.eval("document.querySelectorAll('section.group').length").get<int>(), 1);
+        EXPECT_EQ(b.eval("document.querySelector('section.group').getAttribute('data-members')").get<std::string>(), "45");
+        // One card open, its viewer drawn; the others folded.
+        EXPECT_EQ(b.eval("Array.from(document.querySelectorAll('section.test.s-fail')).filter(function(c){"
+                         "return c.getBoundingClientRect().height>0;}).length")
+                      .get<int>(),
+                  1);
+        EXPECT_EQ(body(b, "data-viewers-ready"), "1");
+        auto bottom = [&](const std::string& sel) {
+            return b.eval("document.querySelector(" + json(sel).dump() + ").getBoundingClientRect().bottom").get<double>();
+        };
+        EXPECT_LE(bottom("section.group h2.ghead"), 900);
+        EXPECT_LE(bottom("section.group .cmd.bless-group"), 900);
+        EXPECT_LE(b.eval("document.querySelector('section.group canvas.cv-img').getBoundingClientRect().top").get<double>() + 100,
+                  900);
+        // The group's command is short and names the shared option, not 45 names.
+        const std::string cmd =
+            b.eval("document.querySelector('section.group .cmd.bless-group code').textContent").get<std::string>();
+        EXPECT_EQ(cmd, "iblcheck bless --suite 'ci' --filter '*mip_mapping=*'");
+        const std::string all = b.eval("document.querySelector('.cmd.bless-all code').textContent").get<std::string>();
+        EXPECT_EQ(all, cmd);
+        // Unfolded, a member's tile opens its card and its viewer draws.
+        b.eval("document.querySelector('details.gmore').open=true");
+        auto [tx, ty] = b.centre_of("details.gmore .tile");
+        b.click(tx, ty);
+        ASSERT_TRUE(
+            b.wait_for("(function(){var t=document.querySelector('details.gmore .tile');var c=document.getElementById("
+                       "t.dataset.card);return !c.hidden && c.querySelector('.viewer').getAttribute('data-ready')==='1';})()"));
+        b.eval("document.querySelector('details.gmore').open=false;window.scrollTo(0,0)");
+        save(b.screenshot(false), "report_ci45_first_screen.png");
+        for (const std::string& e : b.errors()) ADD_FAILURE() << "page: " << e;
+    }
+    fs::remove_all(dir);
+}
