@@ -71,6 +71,7 @@ void print_run_summary(const json& R, const RunSummary& s, size_t n_tests, const
     fmt::print("{} tests: {} pass, {} fail, {} improved, {} missing-golden, {} error  ({:.1f} s){}\n", n_tests, s.pass, s.fail,
                s.improved, s.missing, s.error, R["total_s"].get<double>(),
                o.out_dir.empty() ? "" : "  report: " + (o.out_dir / "index.html").string());
+    if (!o.history.empty()) fmt::print("history: {} (the History tab's trends)\n", o.history.string());
     print_groups(R, suite_arg, shader_arg);
     if (std::string all = rebless_all_line(R["tests"], suite_arg, shader_arg, report::ran_whole_suite(R)); !all.empty())
         fmt::print("{}\n", all);

@@ -464,7 +464,7 @@ Suite load_suite(const std::string& name_or_path, const std::string& shader) {
     }
     Ctx c{file.string()};
     json root = parse_json_file(file.string()); // a folder or a FIFO: refused, not read
-    c.keys(root, "(top level)", {"suite", "description", "defaults", "tests"});
+    c.keys(root, "(top level)", {"suite", "description", "history", "defaults", "tests"});
     if (!root.contains("suite")) c.fail("suite", "missing required key");
     if (!root.contains("tests")) c.fail("tests", "missing required key");
     Suite suite;
@@ -474,6 +474,11 @@ Suite load_suite(const std::string& name_or_path, const std::string& shader) {
     suite.arg = fs::path(name_or_path).extension() == ".json" ? fs::absolute(file).lexically_normal().string() : name_or_path;
     suite.name = c.str(root["suite"], "suite");
     if (root.contains("description")) suite.description = c.str(root["description"], "description");
+    if (root.contains("history")) {
+        suite.history = c.str(root["history"], "history");
+        if (suite.history.empty() || fs::path(suite.history).is_absolute())
+            c.fail("history", "must be a file name relative to the folder that holds --out");
+    }
     SuiteDefaults defaults = parse_defaults(c, root.value("defaults", json::object()), suite);
     std::string shader_arg; // --shader: every mobile test's, over the suite's own
     if (!shader.empty()) {

@@ -125,6 +125,9 @@ struct Suite {
     std::string arg; // the suite's name, or the absolute path it was loaded from
     int jobs = 2;
     int timing_repeats = 1; // renders per test whose frame times give a median and range
+    // "history": the history file a run with --out and no --history appends to, a path relative to
+    // the folder that holds --out (beside the output: the History tab works for whoever runs it).
+    std::string history;
     std::vector<TestCase> tests;
 };
 

@@ -521,3 +521,29 @@ TEST(RunConsole, FortyFiveFailuresOfOneCausePrintUnderSixtyLines) {
         std::string::npos)
         << out;
 }
+
+// The nightly's History tab is not empty for whoever runs it as the README says (issue 32): a run
+// with --out and no --history appends to the suite's history file beside --out.
+TEST(Suite, NightlyAppendsToAHistoryBesideItsOutputByDefault) {
+    const Suite nightly = load_suite("nightly");
+    EXPECT_EQ(nightly.history, "nightly_history.jsonl");
+    RunOptions o;
+    o.out_dir = "runs/nightly/";
+    EXPECT_EQ(with_suite_history(o, nightly).history, fs::absolute("runs/nightly_history.jsonl").lexically_normal());
+    o.history = "mine.jsonl";
+    EXPECT_EQ(with_suite_history(o, nightly).history, "mine.jsonl") << "--history wins";
+    o = RunOptions{};
+    EXPECT_TRUE(with_suite_history(o, nightly).history.empty()) << "no --out: nothing written";
+    o.out_dir = "x";
+    EXPECT_TRUE(with_suite_history(o, load_suite("ci")).history.empty()) << "ci keeps none";
+    const fs::path dir = temp_dir("suite_history");
+    write_file(dir / "h.json",
+               R"({"suite": "h", "history": "/tmp/h.jsonl", "tests": [{"scene": "sphere", "method": "mobile"}]})");
+    try {
+        load_suite((dir / "h.json").string());
+        ADD_FAILURE() << "an absolute history path was accepted";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("history"), std::string::npos) << e.what();
+    }
+    fs::remove_all(dir);
+}
