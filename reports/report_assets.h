@@ -113,6 +113,7 @@ section.group{border-left:4px solid var(--fail);padding-left:10px;margin:8px 0 1
 h2.ghead{font-size:15px;margin:4px 0}
 details.gmore>summary{cursor:pointer;color:var(--mut);font-size:13px;margin:6px 0}
 table.since td.info{color:var(--mut)}
+table.sortable th[data-sort]{cursor:pointer}table.sortable th[data-dir=asc]::after{content:" \25B2"}table.sortable th[data-dir=desc]::after{content:" \25BC"}
 )CSS";
 
 } // namespace iblcheck::report::assets

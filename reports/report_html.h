@@ -100,6 +100,13 @@ void test_tile(std::string& o, const json& t, size_t idx, PageContext& ctx);
 // shader tree, commit, driver and CPU class, blessed with and now; "" when no baseline was judged.
 std::string since_baselines_html(const json& results, const std::vector<const json*>& tests);
 
+// The change (%) of a test's mean FLIP against the truth since the latest earlier run in `runs`
+// (history entries, oldest first, this run last) that measured it; nullopt without one.
+std::optional<double> accuracy_drift(const std::vector<const json*>& runs, const std::string& test);
+// The table of all tests (report_table.cpp): verdict, name, FLIP vs golden and vs the truth, drift,
+// cost, times, message; numeric columns sort on a click (data-sort, the script). drift[i]: test i's.
+std::string tests_table(const std::vector<const json*>& tests, const std::vector<std::optional<double>>& drift);
+
 // The charts tab: cost against accuracy, wall time (median and range), error against roughness,
 // flicker against FLIP, each as small multiples. tests[i] is the page's test i (its id test_id(i)).
 std::string charts_html(const std::vector<const json*>& tests);

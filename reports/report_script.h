@@ -34,7 +34,8 @@ inline constexpr const char* kJs = R"JS(
     var h=location.hash.slice(1);
     if(h==='charts'||h==='history'||h==='table'){showTab(h);return;}
     showTab('tests');
-    if(/^t-\d+$/.test(h)){var c=document.getElementById(h);if(c){openCard(c,false);c.scrollIntoView();}}
+    if(/^t-\d+$/.test(h)){var c=document.getElementById(h);if(c){var d=c.closest('details');if(d)d.open=true;
+      openCard(c,false);c.scrollIntoView();}}
   }
   window.addEventListener('hashchange',route);
 
@@ -111,6 +112,21 @@ inline constexpr const char* kJs = R"JS(
   }
   $$('.cmp-tabs button').forEach(function(b){
     b.addEventListener('click',function(){showCmp(b.closest('section.test'),b.getAttribute('data-cmp'));});
+  });
+
+  // ---- sortable tables: a click on a numeric heading sorts by it, again the other way ----
+  $$('table.sortable th[data-sort]').forEach(function(th){
+    th.addEventListener('click',function(){
+      var table=th.closest('table'), body=table.tBodies[0], col=Array.prototype.indexOf.call(th.parentElement.children,th);
+      var dir=th.getAttribute('data-dir')==='asc'?'desc':'asc';
+      $$('th[data-sort]',table).forEach(function(h){h.removeAttribute('data-dir');});
+      th.setAttribute('data-dir',dir);
+      function v(r){var c=r.cells[col],x=c?c.getAttribute('data-v'):null;return x===null||x===''?null:+x;}
+      var rows=Array.prototype.slice.call(body.rows);
+      rows.sort(function(a,b){var x=v(a),y=v(b);if(x===null)return y===null?0:1;if(y===null)return -1;
+        return dir==='asc'?x-y:y-x;});  // empty cells last either way
+      rows.forEach(function(r){body.appendChild(r);});
+    });
   });
 
   // ---- float data: data/<key>.js calls iblcheckData(key, meta, base64) ----

@@ -248,3 +248,49 @@ TEST(ReportBrowser, CiReportWith45FailuresOfOneCauseShowsOneGroupInTheFirstScree
     }
     fs::remove_all(dir);
 }
+
+// A measured run (the nightly: no baselines, nothing failed; issue 32) shows its tests as a table in
+// the first screen, sorted by a click on accuracy, cost or drift since the last run in the history.
+TEST(ReportBrowser, MeasuredRunIsATableSortableByAccuracyCostAndDrift) {
+    if (!Browser::available()) GTEST_SKIP() << Browser::kChromium << " is not installed (Debian package chromium)";
+    const fs::path dir = testutil::temp_dir("browser_measured");
+    testutil::CiRun run = testutil::make_ci_run(dir / "run", 6, 0);
+    json last = {{"commit", "0123456789ab"}, {"date", "2026-11-22T03:00:00Z"}, {"suite", "ci"}, {"tests", json::object()}};
+    for (json& t : run.results["tests"]) {
+        t.erase("comparisons");
+        // Drift since the last run: test k was 0.2 + 0.001 k then; make test 2 jump by +50 %.
+        const double now = t["accuracy"]["flip_mean"].get<double>();
+        last["tests"][t["name"].get<std::string>()] = {
+            {"verdict", "pass"}, {"flip_mean", t["name"] == run.results["tests"][2]["name"] ? now / 1.5 : now}};
+    }
+    report::write_report(run.results, run.dir, run.dir, {last});
+    {
+        Browser b(dir / "profile", 1440, 900);
+        b.open("file://" + (run.dir / "index.html").string(), kReady);
+        expect_loaded(b);
+        const std::string table = "#tab-tests table.sortable";
+        EXPECT_LE(b.eval("document.querySelector('" + table + "').getBoundingClientRect().top").get<double>(), 600);
+        auto names = [&]() {
+            return b.eval("Array.from(document.querySelectorAll('" + table +
+                          " tbody tr')).map(function(r){return "
+                          "r.getAttribute('data-name');})");
+        };
+        auto sort_by = [&](int column) {
+            auto [x, y] = b.centre_of(fmt::format("{} th:nth-child({})", table, column));
+            b.click(x, y);
+        };
+        const json& tests = run.results["tests"];
+        sort_by(5); // drift %, ascending: test 2's +50 % last
+        EXPECT_EQ(names()[5], tests[2]["name"]);
+        sort_by(5); // again: descending, test 2 first
+        EXPECT_EQ(names()[0], tests[2]["name"]);
+        sort_by(4); // FLIP vs the truth ascending: 0.2 + 0.001 k in test order
+        for (int k = 0; k < 6; ++k) EXPECT_EQ(names()[k], tests[k]["name"]) << k;
+        sort_by(6); // SPIR-V instr/px: 6276 + k, ascending
+        EXPECT_EQ(names()[0], tests[0]["name"]);
+        EXPECT_EQ(b.eval("document.querySelector('" + table + " tbody tr td:nth-child(5)').textContent").get<std::string>(),
+                  "+0.0");
+        for (const std::string& e : b.errors()) ADD_FAILURE() << "page: " << e;
+    }
+    fs::remove_all(dir);
+}
