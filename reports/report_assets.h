@@ -114,6 +114,7 @@ h2.ghead{font-size:15px;margin:4px 0}
 details.gmore>summary{cursor:pointer;color:var(--mut);font-size:13px;margin:6px 0}
 table.since td.info{color:var(--mut)}
 table.sortable th[data-sort]{cursor:pointer}table.sortable th[data-dir=asc]::after{content:" \25B2"}table.sortable th[data-dir=desc]::after{content:" \25BC"}
+.fclegend{display:inline-flex;font-size:10px;vertical-align:middle}.fclegend span{padding:1px 3px;color:#fff;text-shadow:0 0 2px #000}
 )CSS";
 
 } // namespace iblcheck::report::assets

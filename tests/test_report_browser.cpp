@@ -294,3 +294,60 @@ TEST(ReportBrowser, MeasuredRunIsATableSortableByAccuracyCostAndDrift) {
     }
     fs::remove_all(dir);
 }
+
+// Under a bright sun one exposure blows out half the spheres (issue 32): the viewer's false colour
+// paints each pixel by its stop of luminance (the same band the C++ computes from the float data),
+// and the exposure per sphere leaves no sphere blown out. Display only: the figures stay.
+TEST(ReportBrowser, FalseColourAndExposurePerSphereShowWhatOneExposureBlowsOut) {
+    if (!Browser::available()) GTEST_SKIP() << Browser::kChromium << " is not installed (Debian package chromium)";
+    const fs::path dir = testutil::temp_dir("browser_false");
+    const testutil::CiRun run = testutil::make_ci_run(dir / "run", 3, 1);
+    report::write_report(run.results, run.dir, run.dir);
+    {
+        Browser b(dir / "profile", 1440, 900);
+        b.open("file://" + (run.dir / "index.html").string(), kReady);
+        expect_loaded(b);
+        const std::string card = "section.test.s-fail";
+        auto mode = [&](const std::string& m) {
+            b.eval("(function(){var s=document.querySelector('" + card + " select.dmode');s.value='" + m +
+                   "';s.dispatchEvent(new Event('change'));})()");
+        };
+        auto [x0, y0] = b.centre_of(card + " button.ev-0");
+        b.click(x0, y0);
+        mode("false");
+        EXPECT_FALSE(b.eval("document.querySelector('" + card + " .fclegend').hidden").get<bool>());
+        const json palette = b.eval("window.iblcheckFalseColour");
+        ASSERT_EQ(palette.size(), 15u);
+        int checked = 0;
+        for (int sphere = 0; sphere < run.width / 48; sphere += 2) {
+            const int px = 24 + 48 * sphere, py = 24;
+            const cv::Vec3f c = run.failing_test.at<cv::Vec3f>(py, px);
+            const double L = 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+            if (!(L > 0)) continue;
+            const int band = int(std::floor(std::log2(L / 0.18) + 0.5)) + 7;
+            const json want = band < 0 ? json({0, 0, 0}) : band > 14 ? json({255, 255, 255}) : palette[band];
+            const json got = b.eval(fmt::format("Array.from(document.querySelector('{} canvas.cv-img').getContext('2d')"
+                                                ".getImageData({},{},1,1).data).slice(0,3)",
+                                                card, px, py));
+            EXPECT_EQ(got, want) << "sphere " << sphere << " L " << L;
+            ++checked;
+        }
+        EXPECT_GE(checked, 5);
+        save(b.screenshot(false), "report_false_colour.png");
+        // Blown-out pixels (every channel at 254 or more): some at +6 EV with one exposure, none per sphere.
+        const std::string blown = "(function(){var c=document.querySelector('" + card +
+                                  " canvas.cv-img'),d=c.getContext('2d').getImageData(0,0,c.width,c.height).data,n=0;"
+                                  "for(var i=0;i<d.length;i+=4)if(d[i]>=254&&d[i+1]>=254&&d[i+2]>=254)n++;return n;})()";
+        mode("exp");
+        b.eval("(function(){var e=document.querySelector('" + card +
+               " input.ev');e.value=6;e.dispatchEvent(new Event('input'));})()");
+        EXPECT_GT(b.eval(blown).get<int>(), 100);
+        mode("sphere");
+        auto [ax, ay] = b.centre_of(card + " button.ev-auto");
+        b.click(ax, ay);
+        EXPECT_EQ(b.eval(blown).get<int>(), 0);
+        save(b.screenshot(false), "report_exposure_per_sphere.png");
+        for (const std::string& e : b.errors()) ADD_FAILURE() << "page: " << e;
+    }
+    fs::remove_all(dir);
+}
