@@ -115,6 +115,7 @@ details.gmore>summary{cursor:pointer;color:var(--mut);font-size:13px;margin:6px 
 table.since td.info{color:var(--mut)}
 table.sortable th[data-sort]{cursor:pointer}table.sortable th[data-dir=asc]::after{content:" \25B2"}table.sortable th[data-dir=desc]::after{content:" \25BC"}
 .fclegend{display:inline-flex;font-size:10px;vertical-align:middle}.fclegend span{padding:1px 3px;color:#fff;text-shadow:0 0 2px #000}
+table.sortable{max-width:100%}table.sortable td:nth-child(2){word-break:break-all}
 )CSS";
 
 } // namespace iblcheck::report::assets
