@@ -39,6 +39,7 @@ json baseline_facts(const json& golden) {
     json out = json::object();
     for (const char* k : {"commit", "date", "shader_tree_hash", "cpu_class", "label"})
         if (golden.contains(k) && golden[k].is_string()) out[k] = golden[k];
+    if (golden.contains("shader_files") && golden["shader_files"].is_object()) out["shader_files"] = golden["shader_files"];
     const json driver = golden.value("driver", json::object());
     if (driver.is_object() && driver.contains("driver_info") && driver["driver_info"].is_string())
         out["driver_info"] = driver["driver_info"];

@@ -45,6 +45,7 @@ PoolOutcome run_tests(const std::vector<TestCase>& tests, const RunOptions& o, c
     std::mutex print_mutex, driver_mutex;
     json driver;
     const bool interactive = isatty(STDOUT_FILENO);
+    ConsoleBudget budget;
     std::exception_ptr failure; // what stopped a worker (no device), rethrown after the join
     auto work = [&] {
         try {
@@ -58,7 +59,7 @@ PoolOutcome run_tests(const std::vector<TestCase>& tests, const RunOptions& o, c
                 int n = ++done;
                 if (!o.quiet) {
                     std::lock_guard lock(print_mutex);
-                    print_test_line(results[i], n, tests.size(), interactive);
+                    print_test_line(results[i], n, tests.size(), interactive, budget);
                 }
             }
             std::lock_guard lock(driver_mutex);
@@ -146,8 +147,18 @@ int RunSummary::exit_code() const {
     return kExitPass;
 }
 
-RunSummary run_suite(const RunOptions& o) {
-    Suite suite = load_suite(o.suite, o.shader);
+// The suite's history file beside --out when the run names none (suite.h: Suite::history).
+RunOptions with_suite_history(RunOptions o, const Suite& suite) {
+    if (!o.history.empty() || suite.history.empty() || o.out_dir.empty()) return o;
+    fs::path out = fs::absolute(o.out_dir).lexically_normal();
+    if (out.filename().empty()) out = out.parent_path(); // "nightly/"
+    o.history = out.parent_path() / suite.history;
+    return o;
+}
+
+RunSummary run_suite(const RunOptions& options) {
+    const Suite suite = load_suite(options.suite, options.shader);
+    const RunOptions o = with_suite_history(options, suite);
     std::vector<TestCase> tests = select_tests(suite, o.filter, o.shard_index, o.shard_count);
     if (tests.empty()) throw UsageError("no test in suite " + suite.name + " matches --filter '" + o.filter + "'");
     GoldenStore store(o.goldens);

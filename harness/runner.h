@@ -48,4 +48,8 @@ struct RunSummary {
 
 RunSummary run_suite(const RunOptions& options);
 
+// `o` with --history set to the suite's history file beside --out (Suite::history) when the run
+// names no --history and has an --out; otherwise `o` unchanged.
+RunOptions with_suite_history(RunOptions o, const Suite& suite);
+
 } // namespace iblcheck

@@ -1,5 +1,7 @@
 #include "suite.h"
 
+#include "harness/common/name_filter.h"
+
 #include <fnmatch.h>
 
 #include <fmt/core.h>
@@ -222,20 +224,7 @@ std::vector<std::string> suite_names() {
 // Several globs separated by '|' match a name when one of them does (the "approve all failures"
 // line names each failing test). A '|' after a backslash is part of its glob: a test name (an
 // environment file's name) may hold one, and glob_escape writes it so.
-bool glob_match(const std::string& pattern, const std::string& name) {
-    if (pattern.empty()) return true;
-    std::string one;
-    for (size_t i = 0; i <= pattern.size(); ++i) {
-        if (i == pattern.size() || pattern[i] == '|') {
-            if (fnmatch(one.c_str(), name.c_str(), 0) == 0) return true;
-            one.clear();
-            continue;
-        }
-        one += pattern[i];
-        if (pattern[i] == '\\' && i + 1 < pattern.size()) one += pattern[++i];
-    }
-    return false;
-}
+bool glob_match(const std::string& pattern, const std::string& name) { return name_filter_match(pattern, name); }
 
 namespace {
 
@@ -475,7 +464,7 @@ Suite load_suite(const std::string& name_or_path, const std::string& shader) {
     }
     Ctx c{file.string()};
     json root = parse_json_file(file.string()); // a folder or a FIFO: refused, not read
-    c.keys(root, "(top level)", {"suite", "description", "defaults", "tests"});
+    c.keys(root, "(top level)", {"suite", "description", "history", "defaults", "tests"});
     if (!root.contains("suite")) c.fail("suite", "missing required key");
     if (!root.contains("tests")) c.fail("tests", "missing required key");
     Suite suite;
@@ -485,6 +474,11 @@ Suite load_suite(const std::string& name_or_path, const std::string& shader) {
     suite.arg = fs::path(name_or_path).extension() == ".json" ? fs::absolute(file).lexically_normal().string() : name_or_path;
     suite.name = c.str(root["suite"], "suite");
     if (root.contains("description")) suite.description = c.str(root["description"], "description");
+    if (root.contains("history")) {
+        suite.history = c.str(root["history"], "history");
+        if (suite.history.empty() || fs::path(suite.history).is_absolute())
+            c.fail("history", "must be a file name relative to the folder that holds --out");
+    }
     SuiteDefaults defaults = parse_defaults(c, root.value("defaults", json::object()), suite);
     std::string shader_arg; // --shader: every mobile test's, over the suite's own
     if (!shader.empty()) {

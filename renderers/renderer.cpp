@@ -119,6 +119,7 @@ RenderResult Renderer::render(const TestSpec& spec) {
         r.provenance["shader_tree_hash"] = spec.shader.empty()
                                                ? vk::shader_tree_hash()
                                                : combined_shader_hash(vk::shader_tree_hash(), vk::ibl_shade_hash(spec.shader));
+        r.provenance["shader_files"] = vk::shader_file_hashes(); // which files changed, not only that one did
         r.provenance["driver"] = driver_json();
     }
     r.coverage = sphere_coverage(build_scene(spec.scene, spec.options), r.image.cols, r.image.rows);

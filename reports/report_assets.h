@@ -109,6 +109,13 @@ svg.spark line.moved{stroke:#e03131;stroke-dasharray:2 2}svg.spark text.moved{fo
 .charts{display:flex;flex-wrap:wrap}
 footer{color:var(--mut);font-size:12px;margin-top:20px}
 [hidden]{display:none!important}
+section.group{border-left:4px solid var(--fail);padding-left:10px;margin:8px 0 16px}
+h2.ghead{font-size:15px;margin:4px 0}
+details.gmore>summary{cursor:pointer;color:var(--mut);font-size:13px;margin:6px 0}
+table.since td.info{color:var(--mut)}
+table.sortable th[data-sort]{cursor:pointer}table.sortable th[data-dir=asc]::after{content:" \25B2"}table.sortable th[data-dir=desc]::after{content:" \25BC"}
+.fclegend{display:inline-flex;font-size:10px;vertical-align:middle}.fclegend span{padding:1px 3px;color:#fff;text-shadow:0 0 2px #000}
+table.sortable{max-width:100%}table.sortable td:nth-child(2){word-break:break-all}
 )CSS";
 
 } // namespace iblcheck::report::assets

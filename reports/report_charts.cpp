@@ -30,6 +30,8 @@ std::string slug(const std::string& g) {
     }
     return o;
 }
+// The run's failing tests are marked on the charts (issue 32).
+bool failed_now(const json& t) { return str(t, "verdict") == "fail" || str(t, "verdict") == "error"; }
 std::string group_of(const json& t) { return str(t, "scene") + " \u00b7 " + str(t, "env"); }
 
 // One marker per variant family, in order of first appearance (stable across panels): the shapes,
@@ -98,6 +100,7 @@ Chart accuracy_chart(const std::string& id, const std::string& title, ChartAxis 
         p.y = *f;
         p.label = point_label(t);
         p.tooltip = fmt::format("{}\n{}, mean FLIP vs the truth {}", str(t, "name"), detail(t, p), fmt_num(*f));
+        p.failed = failed_now(t);
         p.href = "#" + test_id(page[k]);
         c.series[series[key]].points.push_back(std::move(p));
         xs.push_back(*x);
@@ -196,6 +199,7 @@ std::string roughness_panel(const std::string& id, const std::string& title, con
             p.y = num(s, "flip_mean").value_or(0);
             p.tooltip = fmt::format("{}\n{}: roughness {}, metallic {}, FLIP {}", str(t, "name"), str(s, "label"), fmt_num(p.x),
                                     fmt_num(m), fmt_num(p.y));
+            p.failed = failed_now(t);
             p.href = "#" + test_id(page[k]);
             (m >= 0.5 ? metal : diel).points.push_back(std::move(p));
         }
@@ -367,6 +371,7 @@ void flicker_section(std::string& o, const std::vector<const json*>& tests) {
         p.y = *fl;
         p.label = test_label(t) + " \u00b7 " + str(t, "env"); // method, variant and environment
         p.tooltip = fmt::format("{}\nFLIP = {}, flicker = {}", str(t, "name"), fmt_num(*fm), fmt_num(*fl));
+        p.failed = failed_now(t);
         p.href = "#" + test_id(i);
         it->points.push_back(std::move(p));
     }

@@ -11,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "reports/failure_groups.h"
 #include "reports/float_data.h"
 #include "reports/svg_chart.h"
 
@@ -87,12 +88,24 @@ void viewer_html(std::string& o, PageContext& ctx, const json& t, const ViewerSp
 // A test's full card (<section class="test ...">): expanded for what needs a look, folded (hidden,
 // opened from its tile) for a pass.
 void test_card(std::string& o, const json& t, size_t idx, PageContext& ctx, const Trend& trend, bool expanded);
+// Failures that share a cause (failure_groups.h), group `k` (report_groups.cpp): what they share,
+// the group's one approve command, the representative's card expanded, the others' tiles folded in a
+// <details> (each opens its card).
+void group_section(std::string& o, const std::vector<const json*>& tests, const FailureGroup& g, size_t k,
+                   const std::string& bless_line, PageContext& ctx, const std::vector<Trend>& trends);
 // A passing test's thumbnail tile in the grid; clicking it opens the card.
 void test_tile(std::string& o, const json& t, size_t idx, PageContext& ctx);
 
 // The summary's table of what changed since the baselines were blessed (since_baselines.cpp):
 // shader tree, commit, driver and CPU class, blessed with and now; "" when no baseline was judged.
 std::string since_baselines_html(const json& results, const std::vector<const json*>& tests);
+
+// The change (%) of a test's mean FLIP against the truth since the latest earlier run in `runs`
+// (history entries, oldest first, this run last) that measured it; nullopt without one.
+std::optional<double> accuracy_drift(const std::vector<const json*>& runs, const std::string& test);
+// The table of all tests (report_table.cpp): verdict, name, FLIP vs golden and vs the truth, drift,
+// cost, times, message; numeric columns sort on a click (data-sort, the script). drift[i]: test i's.
+std::string tests_table(const std::vector<const json*>& tests, const std::vector<std::optional<double>>& drift);
 
 // The charts tab: cost against accuracy, wall time (median and range), error against roughness,
 // flicker against FLIP, each as small multiples. tests[i] is the page's test i (its id test_id(i)).

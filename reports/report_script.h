@@ -34,7 +34,8 @@ inline constexpr const char* kJs = R"JS(
     var h=location.hash.slice(1);
     if(h==='charts'||h==='history'||h==='table'){showTab(h);return;}
     showTab('tests');
-    if(/^t-\d+$/.test(h)){var c=document.getElementById(h);if(c){openCard(c,false);c.scrollIntoView();}}
+    if(/^t-\d+$/.test(h)){var c=document.getElementById(h);if(c){var d=c.closest('details');if(d)d.open=true;
+      openCard(c,false);c.scrollIntoView();}}
   }
   window.addEventListener('hashchange',route);
 
@@ -113,6 +114,21 @@ inline constexpr const char* kJs = R"JS(
     b.addEventListener('click',function(){showCmp(b.closest('section.test'),b.getAttribute('data-cmp'));});
   });
 
+  // ---- sortable tables: a click on a numeric heading sorts by it, again the other way ----
+  $$('table.sortable th[data-sort]').forEach(function(th){
+    th.addEventListener('click',function(){
+      var table=th.closest('table'), body=table.tBodies[0], col=Array.prototype.indexOf.call(th.parentElement.children,th);
+      var dir=th.getAttribute('data-dir')==='asc'?'desc':'asc';
+      $$('th[data-sort]',table).forEach(function(h){h.removeAttribute('data-dir');});
+      th.setAttribute('data-dir',dir);
+      function v(r){var c=r.cells[col],x=c?c.getAttribute('data-v'):null;return x===null||x===''?null:+x;}
+      var rows=Array.prototype.slice.call(body.rows);
+      rows.sort(function(a,b){var x=v(a),y=v(b);if(x===null)return y===null?0:1;if(y===null)return -1;
+        return dir==='asc'?x-y:y-x;});  // empty cells last either way
+      rows.forEach(function(r){body.appendChild(r);});
+    });
+  });
+
   // ---- float data: data/<key>.js calls iblcheckData(key, meta, base64) ----
   var RAW={}, WAIT={}, DEC={}, H2F=null;
   window.iblcheckData=function(key,meta,b64){
@@ -172,6 +188,48 @@ inline constexpr const char* kJs = R"JS(
     for(var i=0,j=0,o=0;i<w*h;i++,j+=c,o+=4){
       var r=v[j]*s, g=c>2?v[j+1]*s:r, b=c>2?v[j+2]*s:r;
       d[o]=(tone(r)*255+0.5)|0;d[o+1]=(tone(g)*255+0.5)|0;d[o+2]=(tone(b)*255+0.5)|0;d[o+3]=255;
+    }
+    ctx.putImageData(id,0,0);
+  }
+  // False colour: one colour per stop of luminance (Rec. 709 weights, linear) against 0.18 at the
+  // chosen exposure, -7..+7 stops; black below, white above. Display only.
+  var FALSE=[[20,0,60],[50,0,120],[40,40,200],[0,100,230],[0,160,220],[0,200,160],[0,190,60],[110,110,110],
+             [140,220,0],[230,230,0],[255,190,0],[255,130,0],[255,60,0],[220,0,60],[255,0,200]];
+  window.iblcheckFalseColour=FALSE;
+  function stopBand(L,s){
+    if(!(L>0))return -1;
+    var b=Math.floor(Math.log2(L*s/0.18)+0.5)+7;
+    return b<0?-1:(b>14?15:b);
+  }
+  function luminance(v,j,c){return c>2?0.2126*v[j]+0.7152*v[j+1]+0.0722*v[j+2]:v[j];}
+  // Exposure per sphere: each sphere (ids) at the exposure that puts its brightest channel at 1, so
+  // no sphere is blown out and a sun's highlight keeps its shape; the background at the image's.
+  // Returns the EV of each sphere id.
+  function sphereEv(img,ids,base){
+    var m=img.meta, c=m.c, v=img.v, n=m.w*m.h, peak={}, out={};
+    if(!ids)return out;
+    for(var i=0;i<n;i++){
+      var id=ids.v[i];if(!id)continue;
+      for(var k=0;k<Math.min(c,3);k++)if(!(peak[id]>=v[i*c+k]))peak[id]=v[i*c+k];
+    }
+    Object.keys(peak).forEach(function(id){out[id]=peak[id]>0?Math.log2(1/peak[id]):base;});
+    return out;
+  }
+  function paintMode(cv,img,ev,mode,ids,sev,auto){
+    if(mode==='exp')return paintImage(cv,img,ev);
+    var m=img.meta, w=m.w, h=m.h, c=m.c, v=img.v;
+    cv.width=w;cv.height=h;
+    var ctx=cv.getContext('2d'), id=ctx.createImageData(w,h), d=id.data;
+    for(var i=0,j=0,o=0;i<w*h;i++,j+=c,o+=4){
+      if(mode==='false'){
+        var b=stopBand(luminance(v,j,c),Math.pow(2,ev)), col=b<0?[0,0,0]:(b>14?[255,255,255]:FALSE[b]);
+        d[o]=col[0];d[o+1]=col[1];d[o+2]=col[2];
+      }else{
+        var k=ids?ids.v[i]:0, s=Math.pow(2,(k&&sev[k]!==undefined?sev[k]:auto)+ev-auto);
+        var r=v[j]*s, g=c>2?v[j+1]*s:r, bl=c>2?v[j+2]*s:r;
+        d[o]=(tone(r)*255+0.5)|0;d[o+1]=(tone(g)*255+0.5)|0;d[o+2]=(tone(bl)*255+0.5)|0;
+      }
+      d[o+3]=255;
     }
     ctx.putImageData(id,0,0);
   }
@@ -242,9 +300,18 @@ inline constexpr const char* kJs = R"JS(
     }
     if(tolIn)tolIn.value=String(st.tol);
     function label(id){var s=spheres[id-1];return s?s.label:'';}
+    var autoEv=+(test.meta.auto||0), sevT=null, sevG=null, dmode=$('select.dmode',v), fcl=$('.fclegend',v);
+    st.mode='exp';
     function paintImages(){
-      paintImage(offT,test,st.ev);
-      if(gold)paintImage(offG,gold,st.ev);
+      if(st.mode==='sphere'&&!sevT){sevT=sphereEv(test,ids,autoEv);sevG=gold?sphereEv(gold,ids,autoEv):{};}
+      paintMode(offT,test,st.ev,st.mode,ids,sevT||{},autoEv);
+      if(gold)paintMode(offG,gold,st.ev,st.mode,ids,sevG||{},autoEv);
+      if(fcl){
+        fcl.hidden=st.mode!=='false';
+        if(!fcl.firstChild)FALSE.forEach(function(col,b){var sp=document.createElement('span');
+          sp.style.background='rgb('+col.join(',')+')';sp.textContent=(b-7>0?'+':'')+(b-7);fcl.appendChild(sp);});
+        fcl.title='stops of luminance against 0.18 at '+st.ev.toFixed(1)+' EV; black below -7, white above +7';
+      }
       var src=(st.show==='golden'&&gold)?offG:offT;
       cvImg.width=w;cvImg.height=h;cvImg.getContext('2d').drawImage(src,0,0);
       evOut.textContent=(st.ev>0?'+':'')+st.ev.toFixed(1)+' EV'+(Math.abs(st.ev-(test.meta.auto||0))<0.05?' (auto)':'');
@@ -315,6 +382,7 @@ inline constexpr const char* kJs = R"JS(
     if(ev)ev.addEventListener('input',function(){st.ev=+ev.value;paintImages();});
     var ba=$('button.ev-auto',v);if(ba)ba.addEventListener('click',function(){st.ev=+(test.meta.auto||0);paintImages();});
     var b0=$('button.ev-0',v);if(b0)b0.addEventListener('click',function(){st.ev=0;paintImages();});
+    if(dmode)dmode.addEventListener('change',function(){st.mode=dmode.value;paintImages();});
     $$('button.show',v).forEach(function(b){b.addEventListener('click',function(){st.show=b.getAttribute('data-show');paintImages();});});
     var bl=$('input.blink',v);
     if(bl)bl.addEventListener('change',function(){

@@ -55,7 +55,11 @@ void viewer_toolbar(std::string& o, const ViewerSpec& vs, bool has_golden, bool 
     o += "<div class=\"vbar\"><label>exposure <input type=\"range\" class=\"ev\" min=\"-12\" max=\"12\" step=\"0.1\" "
          "value=\"0\" aria-label=\"exposure in stops\"></label><output class=\"evv\">0.0 EV</output>"
          "<button type=\"button\" class=\"ev-auto\" title=\"this image's automatic exposure\">auto</button>"
-         "<button type=\"button\" class=\"ev-0\" title=\"the PNG's exposure\">0 EV</button>";
+         "<button type=\"button\" class=\"ev-0\" title=\"the PNG's exposure\">0 EV</button>"
+         // Display only (issue 32): under a 1e5 sun one exposure blows out half the spheres.
+         "<select class=\"dmode\" aria-label=\"display\" title=\"display only: the scores do not change\"><option "
+         "value=\"exp\">one exposure</option><option value=\"sphere\">exposure per sphere</option><option "
+         "value=\"false\">false colour (stops)</option></select><span class=\"fclegend\" hidden></span>";
     if (has_golden)
         fmt::format_to(out,
                        "<span><button type=\"button\" class=\"show on\" data-show=\"test\">test</button><button "

@@ -19,6 +19,7 @@
 #include "metrics/flip/tone_mappers.h"
 #include "reports/drift.h"
 #include "reports/nightly_findings.h"
+#include "reports/failure_groups.h"
 #include "reports/report_assets.h"
 #include "reports/report_html.h"
 #include "reports/report_script.h"
@@ -202,7 +203,8 @@ void summary_section(std::string& o, const json& results, const std::vector<cons
                        e(str(results, "command")));
     json arr = json::array();
     for (const json* t : tests) arr.push_back(*t);
-    const std::string all_line = rebless_all_line(arr, bless_argument(tests, "--suite "), bless_argument(tests, "--shader "));
+    const std::string all_line =
+        rebless_all_line(arr, bless_argument(tests, "--suite "), bless_argument(tests, "--shader "), ran_whole_suite(results));
     const size_t colon = all_line.find("): ") == std::string::npos ? std::string::npos : all_line.find("): ") + 1;
     if (colon != std::string::npos)
         fmt::format_to(out,
@@ -255,14 +257,27 @@ void failure_modes(std::string& o, const std::vector<const json*>& tests) {
 }
 
 // Tests: failures expanded, then the grid of passing tests, then the failure modes.
-void tests_tab(std::string& o, const std::vector<const json*>& tests, PageContext& ctx, const std::vector<Trend>& trends) {
+void tests_tab(std::string& o, const std::vector<const json*>& tests, const std::vector<FailureGroup>& groups, PageContext& ctx,
+               const std::vector<Trend>& trends, const std::vector<std::optional<double>>& drift) {
     o += "<section class=\"tab\" id=\"tab-tests\">\n";
     size_t n_open = 0;
-    for (size_t i = 0; i < tests.size(); ++i)
-        if (str(*tests[i], "verdict") != "pass") {
-            test_card(o, *tests[i], i, ctx, trends[i], true);
-            ++n_open;
-        }
+    const std::string suite_arg = bless_argument(tests, "--suite "), shader_arg = bless_argument(tests, "--shader ");
+    for (size_t k = 0; k < groups.size(); ++k) {
+        group_section(o, tests, groups[k], k, group_bless_line(tests, groups[k], suite_arg, shader_arg), ctx, trends);
+        n_open += groups[k].members.size();
+    }
+    // A measured run (the nightly: nothing failed, nothing has a baseline) reads as a table sorted by
+    // accuracy, cost or drift; its thumbnails are folded under it.
+    const bool measured =
+        n_open == 0 && std::none_of(tests.begin(), tests.end(), [](const json* t) {
+            return sub(*t, "comparisons").is_array() && std::any_of((*t)["comparisons"].begin(), (*t)["comparisons"].end(),
+                                                                    [](const json& c) { return str(c, "kind") == "baseline"; });
+        });
+    if (measured && !tests.empty())
+        o += fmt::format("<h2 id=\"measured\">{} tests measured <span class=\"meta\">click a numeric heading to sort; a "
+                         "name opens its card</span></h2>\n",
+                         tests.size()) +
+             tests_table(tests, drift) + "<details class=\"gmore\"><summary>the thumbnails</summary>\n";
     if (n_open < tests.size()) {
         fmt::format_to(std::back_inserter(o),
                        "<h2 id=\"passing\">{} passing test{} <span class=\"meta\">click a tile to open it</span></h2>\n"
@@ -275,6 +290,7 @@ void tests_tab(std::string& o, const std::vector<const json*>& tests, PageContex
             }
         o += "</div>\n";
     }
+    if (measured && !tests.empty()) o += "</details>\n";
     failure_modes(o, tests);
     o += "</section>\n";
 }
@@ -313,29 +329,11 @@ void history_tab(std::string& o, const std::vector<const json*>& tests, const Hi
     o += "</section>\n";
 }
 
-// The table of all tests.
-void table_tab(std::string& o, const std::vector<const json*>& tests) {
-    o += "<section class=\"tab\" id=\"tab-table\">\n<h2>All tests</h2>\n<table class=\"grid overview\"><tr><th>verdict</th>"
-         "<th>test</th><th>FLIP vs golden</th><th>FLIP vs the truth</th><th>SPIR-V instr/px</th><th>frame ms</th>"
-         "<th>precompute ms</th><th>message</th></tr>\n";
-    for (size_t i = 0; i < tests.size(); ++i) {
-        const json& t = *tests[i];
-        const std::string v = str(t, "verdict");
-        std::optional<double> golden_flip;
-        if (sub(t, "comparisons").is_array())
-            for (const json& c : t["comparisons"])
-                if (!golden_flip) golden_flip = num(sub(sub(c, "metrics"), "flip"), "mean");
-        auto cellnum = [](std::optional<double> x) { return x ? fmt_num(*x) : std::string(); };
-        fmt::format_to(std::back_inserter(o),
-                       "<tr class=\"filterable\" data-name=\"{2}\" data-verdict=\"{0}\"><td><span class=\"badge v-{0}\">"
-                       "{0}</span></td><td><a href=\"#{1}\">{2}</a></td><td class=\"num\">{3}</td><td class=\"num\">{4}"
-                       "</td><td class=\"num\">{5}</td><td class=\"num\">{6}</td><td class=\"num\">{7}</td><td "
-                       "title=\"{9}\">{8}</td></tr>\n",
-                       e(v), test_id(i), e(str(t, "name")), cellnum(golden_flip), cellnum(num(sub(t, "accuracy"), "flip_mean")),
-                       cellnum(num(sub(t, "cost"), "spirv_instructions_per_pixel")), cellnum(num(t, "frame_ms")),
-                       cellnum(num(t, "precompute_ms")), e(short_message(str(t, "message"))), e(str(t, "message")));
-    }
-    o += "</table>\n</section>\n";
+// The table of all tests, sortable (report_table.cpp).
+void table_tab(std::string& o, const std::vector<const json*>& tests, const std::vector<std::optional<double>>& drift) {
+    o += "<section class=\"tab\" id=\"tab-table\">\n<h2>All tests <span class=\"meta\">click a numeric heading to "
+         "sort</span></h2>\n" +
+         tests_table(tests, drift) + "</section>\n";
 }
 
 // Images the results named but the folder lacks, the footer and the scripts.
@@ -386,8 +384,13 @@ void write_report(const json& results, const fs::path& results_dir, const fs::pa
     const bool bad = counts["fail"] + counts["error"] + counts["missing-golden"] > 0;
     const json current = history_entry(results);
     const History hist = history_window(history, current);
+    const std::vector<FailureGroup> groups = group_failures(tests, ran_whole_suite(results));
     std::vector<Trend> trends;
-    for (const json* t : tests) trends.push_back(trend_for(hist, str(*t, "name")));
+    std::vector<std::optional<double>> drift;
+    for (const json* t : tests) {
+        trends.push_back(trend_for(hist, str(*t, "name")));
+        drift.push_back(accuracy_drift(hist.runs, str(*t, "name")));
+    }
 
     std::string o;
     o.reserve(1 << 18);
@@ -395,10 +398,10 @@ void write_report(const json& results, const fs::path& results_dir, const fs::pa
     summary_section(o, results, tests, counts, bad);
     if (findings_wanted(results, findings)) o += findings_html(results, history, findings, store);
     tabs_nav(o, tests.size());
-    tests_tab(o, tests, ctx, trends);
+    tests_tab(o, tests, groups, ctx, trends, drift);
     o += "<section class=\"tab\" id=\"tab-charts\">\n" + charts_html(tests) + "</section>\n";
     history_tab(o, tests, hist, trends);
-    table_tab(o, tests);
+    table_tab(o, tests, drift);
     page_end(o, store, data);
     write_atomically(out_dir, o);
 }

@@ -91,8 +91,15 @@ void check_comparison(const Checker& c, const json& cmp, const std::string& cw) 
         c.string_(*wb, cw + ": worst_block", "sphere");
     }
     if (const json* ap = c.object(cmp, cw, "approved"))
-        for (auto& [k, v] : ap->items())
+        for (auto& [k, v] : ap->items()) {
+            if (k == "shader_files" && v.is_object()) { // {file: content hash} (since_baselines.cpp)
+                for (auto& [f, h] : v.items())
+                    if (!h.is_string())
+                        c.fail(cw, fmt::format("approved.shader_files.{} must be a string, not {}", f, h.type_name()));
+                continue;
+            }
             if (!v.is_string() && !v.is_null()) c.fail(cw, fmt::format("approved.{} must be a string, not {}", k, v.type_name()));
+        }
     if (const json* imgs = c.object(cmp, cw, "images"))
         for (auto& [k, v] : imgs->items())
             if (!v.is_string() && !v.is_null())

@@ -35,8 +35,10 @@ std::vector<size_t> pareto_front(const std::vector<std::pair<double, double>>& p
 }
 
 const std::vector<std::string>& marker_shapes() {
-    static const std::vector<std::string> shapes{"circle", "square", "triangle", "diamond", "triangle-down",
-                                                 "cross",  "plus",   "star",     "hexagon"};
+    // 14 shapes, solid then hollow: 28 glyphs, one per variant family (the nightly has 26; issue 32).
+    static const std::vector<std::string> shapes{"circle",        "square",         "triangle",  "diamond", "triangle-down",
+                                                 "cross",         "plus",           "star",      "hexagon", "pentagon",
+                                                 "triangle-left", "triangle-right", "hourglass", "bowtie"};
     return shapes;
 }
 
@@ -56,6 +58,11 @@ std::string marker_svg(const std::string& shape, double x, double y, double r, c
     if (shape == "triangle") return poly({{0, -1.15}, {1.05, 0.75}, {-1.05, 0.75}});
     if (shape == "triangle-down") return poly({{0, 1.15}, {1.05, -0.75}, {-1.05, -0.75}});
     if (shape == "diamond") return poly({{0, -1.2}, {1.0, 0}, {0, 1.2}, {-1.0, 0}});
+    if (shape == "triangle-left") return poly({{-1.15, 0}, {0.75, -1.05}, {0.75, 1.05}});
+    if (shape == "triangle-right") return poly({{1.15, 0}, {-0.75, -1.05}, {-0.75, 1.05}});
+    if (shape == "hourglass") return poly({{-1, -1}, {1, -1}, {0, 0}, {1, 1}, {-1, 1}, {0, 0}});
+    if (shape == "bowtie") return poly({{-1, -1}, {0, 0}, {1, -1}, {1, 1}, {0, 0}, {-1, 1}});
+    if (shape == "pentagon") return poly({{0.0, -1.1}, {1.05, -0.34}, {0.65, 0.89}, {-0.65, 0.89}, {-1.05, -0.34}});
     if (shape == "cross")
         return poly({{-1, -0.6},
                      {-0.6, -1},
@@ -223,18 +230,34 @@ std::vector<LegendItem> layout_legend(const Chart& c, double W, double px0, doub
     return legend;
 }
 
-// Frame, grid, ticks, axis labels ("no data" when nothing is plotted).
+// A tick's label, short: "250k" and "1.5M" rather than "250000" (issue 32: "100000200000").
+std::string tick_label(double t) {
+    const double a = std::fabs(t);
+    if (a >= 1e6) return fmt_num(t / 1e6) + "M";
+    if (a >= 1e4) return fmt_num(t / 1e3) + "k";
+    return fmt_num(t);
+}
+
+// Frame, grid, ticks, axis labels ("no data" when nothing is plotted); an x tick whose label would
+// touch the one before keeps its grid line and loses its label.
 void axes_svg(std::string& o, const Chart& c, const Plot& pl, bool empty) {
     auto out = std::back_inserter(o);
     const double px0 = pl.px0, px1 = pl.px1, py0 = pl.py0, py1 = pl.py1;
     fmt::format_to(out, "<rect class=\"plot\" x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\"/>\n", px0, py0, px1 - px0, py1 - py0);
+    double last_right = -1e9;
     for (double t : pl.sx.ticks) {
         const double x = pl.sx(t);
-        fmt::format_to(out,
-                       "<line class=\"grid\" x1=\"{0:.1f}\" y1=\"{1}\" x2=\"{0:.1f}\" y2=\"{2}\"/>"
-                       "<line class=\"tick\" x1=\"{0:.1f}\" y1=\"{2}\" x2=\"{0:.1f}\" y2=\"{3}\"/>"
-                       "<text class=\"tl\" x=\"{0:.1f}\" y=\"{4}\" text-anchor=\"middle\">{5}</text>\n",
-                       x, py0, py1, py1 + 5, py1 + 18, fmt_num(t));
+        const std::string label = tick_label(t);
+        const double half = 3.3 * double(label.size()); // ~6.6 px a character at the ticks' 11 px
+        const bool room = x - half >= last_right + 4;
+        if (room) last_right = x + half;
+        fmt::format_to(
+            out,
+            "<line class=\"grid\" x1=\"{0:.1f}\" y1=\"{1}\" x2=\"{0:.1f}\" y2=\"{2}\"/>"
+            "<line class=\"tick\" x1=\"{0:.1f}\" y1=\"{2}\" x2=\"{0:.1f}\" y2=\"{3}\"/>{5}\n",
+            x, py0, py1, py1 + 5, py1 + 18,
+            room ? fmt::format("<text class=\"tl\" x=\"{:.1f}\" y=\"{}\" text-anchor=\"middle\">{}</text>", x, py1 + 18, label)
+                 : std::string());
     }
     for (double t : pl.sy.ticks) {
         const double y = pl.sy(t);
@@ -242,7 +265,7 @@ void axes_svg(std::string& o, const Chart& c, const Plot& pl, bool empty) {
                        "<line class=\"grid\" x1=\"{1}\" y1=\"{0:.1f}\" x2=\"{2}\" y2=\"{0:.1f}\"/>"
                        "<line class=\"tick\" x1=\"{3}\" y1=\"{0:.1f}\" x2=\"{1}\" y2=\"{0:.1f}\"/>"
                        "<text class=\"tl\" x=\"{4}\" y=\"{5:.1f}\" text-anchor=\"end\">{6}</text>\n",
-                       y, px0, px1, px0 - 5, px0 - 8, y + 4, fmt_num(t));
+                       y, px0, px1, px0 - 5, px0 - 8, y + 4, tick_label(t));
     }
     fmt::format_to(out, "<text class=\"al\" x=\"{}\" y=\"{}\" text-anchor=\"middle\">{}{}</text>\n", (px0 + px1) / 2, py1 + 36,
                    html_escape(c.x.label), c.x.log ? " (log scale)" : "");
@@ -312,6 +335,11 @@ void points_svg(std::string& o, const Chart& c, const std::vector<PlotPoint>& pt
         if (p.p->xlo && p.p->xhi && (!c.x.log || *p.p->xlo > 0))
             fmt::format_to(out, "<line class=\"range\" x1=\"{:.1f}\" y1=\"{:.1f}\" x2=\"{:.1f}\" y2=\"{:.1f}\" stroke=\"{}\"/>",
                            pl.sx(*p.p->xlo), y, pl.sx(*p.p->xhi), y, html_escape(s.color));
+        if (p.p->failed)
+            fmt::format_to(out,
+                           "<circle class=\"failed\" cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"8.5\" fill=\"none\" "
+                           "stroke=\"#e03131\" stroke-width=\"2\"><title>failed in this run</title></circle>",
+                           x, y);
         std::string circle = marker_svg(s.marker, x, y, 4.5, s.color, "", s.hollow) +
                              fmt::format(" data-series=\"{}\" data-x=\"{}\" data-y=\"{}\" data-label=\"{}\"><title>{}</title>{}",
                                          html_escape(s.name), p.p->x, p.p->y, html_escape(p.p->label),

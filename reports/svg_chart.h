@@ -23,6 +23,7 @@ struct ChartPoint {
     std::string label;              // drawn next to the point (may be empty)
     std::string tooltip;            // <title>
     std::string href;               // optional link (e.g. "#t-3": the test's card)
+    bool failed = false;            // the test failed in this run: a red ring marks it (issue 32)
 };
 
 struct ChartSeries {
@@ -30,7 +31,8 @@ struct ChartSeries {
     std::string color;
     bool dashed = false;
     bool connect = false; // draw a line through the points (sorted by x)
-    // circle, square, triangle, diamond, triangle-down, cross, plus, star, hexagon (marker_shapes())
+    // circle, square, triangle, diamond, triangle-down, cross, plus, star, hexagon, pentagon,
+    // triangle-left, triangle-right, hourglass, bowtie (marker_shapes())
     std::string marker = "circle";
     bool hollow = false; // marker drawn as an outline
     std::vector<ChartPoint> points;

@@ -3,6 +3,7 @@
 #include <fmt/core.h>
 
 #include "harness/common/shell_quote.h"
+#include "reports/failure_groups.h"
 
 using nlohmann::json;
 
@@ -90,12 +91,15 @@ std::vector<std::string> verdict_details(const json& test) {
     return out;
 }
 
-std::string rebless_all_line(const json& tests, const std::string& suite_arg, const std::string& shader_arg) {
+std::string rebless_all_line(const json& tests, const std::string& suite_arg, const std::string& shader_arg, bool whole_suite) {
     std::string filter, program = "iblcheck", goldens;
+    std::vector<std::string> names, all;
     int n = 0;
     for (const json& t : tests) {
         const std::string v = str(t, "verdict");
+        all.push_back(str(t, "name"));
         if (v != "fail" && v != "missing-golden") continue;
+        names.push_back(str(t, "name"));
         filter += (filter.empty() ? "" : "|") + glob_escape(str(t, "name"));
         // The binary the tests' own bless commands name (the one that ran: build/iblcheck after scripts/run.sh).
         const std::string b = str(t, "bless_command");
@@ -103,6 +107,8 @@ std::string rebless_all_line(const json& tests, const std::string& suite_arg, co
         if (n == 1 && b.find(" --goldens ") != std::string::npos) goldens = b.substr(b.find(" --goldens ")); // the same store
     }
     if (!n) return "";
+    // A whole-suite run: globs that match the failures and no other test, not every name spelt out.
+    if (whole_suite) filter = covering_filter(names, all);
     return fmt::format("approve all {} failure{} (after looking at them): {} bless --suite {}{} --filter {}{}", n,
                        n == 1 ? "" : "s", program, shell_quote(suite_arg),
                        shader_arg.empty() ? "" : " --shader " + shell_quote(shader_arg), shell_quote(filter), goldens);

@@ -23,8 +23,11 @@ std::vector<std::string> verdict_details(const nlohmann::json& test);
 
 // One line that approves every failure (fail and missing-golden) of the run, or "" when there is
 // none: `iblcheck bless --suite 'S' --filter 'a|b|c'` (--filter takes globs separated by '|').
-// `shader_arg`: the run's `--shader FILE`, repeated (empty: none).
-std::string rebless_all_line(const nlohmann::json& tests, const std::string& suite_arg, const std::string& shader_arg = "");
+// `shader_arg`: the run's `--shader FILE`, repeated (empty: none). `whole_suite`: `tests` are every
+// test of the suite (ran_whole_suite, failure_groups.h), so the filter may be globs that match the
+// failures and no other test (covering_filter) instead of every name.
+std::string rebless_all_line(const nlohmann::json& tests, const std::string& suite_arg, const std::string& shader_arg = "",
+                             bool whole_suite = false);
 
 } // namespace iblcheck::report
 

@@ -2,7 +2,7 @@
 // prints the page height and any error the page logged, and writes a screenshot. Used by
 // scripts/report_screenshots.sh for the screenshots committed under reports/screenshots/.
 //
-//   report_browser INDEX.html --out shot.png [--width 1440] [--height 900] [--full] [--tab charts]
+//   report_browser INDEX.html --out shot.png [--width 1440] [--height 900] [--full] [--tab charts] [--js EXPR]
 //                  [--scroll-to ID]   (the element with that id at the top of the screen)
 //
 // Exit 0, or 1 when the page logged an error or an image or data script failed to load.
@@ -26,7 +26,9 @@ int main(int argc, char** argv) {
     app.add_option("--height", height, "viewport height, CSS pixels");
     app.add_option("--tab", tab, "tests (default), charts, history or table");
     app.add_option("--scroll-to", scroll_to, "id of an element to scroll to the top of the screen (e.g. aa-verdict)");
+    std::string js;
     app.add_flag("--full", full, "the whole page, not the first screen");
+    app.add_option("--js", js, "JavaScript to run before the screenshot (e.g. pick the viewer's false colour)");
     CLI11_PARSE(app, argc, argv);
     // The id goes into a script: letters, digits, '-' and '_' only.
     if (scroll_to.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789-_") != std::string::npos) {
@@ -62,6 +64,7 @@ int main(int argc, char** argv) {
             rc = 1;
         }
         if (!b.errors().empty()) rc = 1;
+        if (!js.empty()) b.eval(js);
         std::ofstream(out, std::ios::binary) << b.screenshot(full);
         fmt::print("screenshot: {}\n", out);
     }

@@ -24,8 +24,9 @@ struct SmallRun {
 SmallRun& small_run();
 
 // A ci-like run: `passing` passing tests on 528x96 sweeps of 22 spheres (metal r=0..1 above,
-// dielectric below), and, with `failing`, one failing test first whose baseline differs on one
-// sphere ("metal r=0.5", index 5) by 30 %. Results and files under `dir`.
+// dielectric below), and first `failing` failing tests (variants mip_mapping=ue4,storage=vK, as
+// one shader constant fails them) whose baselines differ on one sphere ("metal r=0.5", index 5) by
+// 30 %; failing_* describe the first. Results and files under `dir`.
 struct CiRun {
     std::filesystem::path dir;
     nlohmann::json results;
@@ -34,6 +35,6 @@ struct CiRun {
     int pixels_over_002 = 0;             // of failing_error (the mask's default threshold 0.02)
     int width = 528, height = 96;
 };
-CiRun make_ci_run(const std::filesystem::path& dir, int passing, bool failing);
+CiRun make_ci_run(const std::filesystem::path& dir, int passing, int failing);
 
 } // namespace iblcheck::testutil

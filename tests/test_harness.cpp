@@ -17,6 +17,7 @@
 #include "harness/common/errors.h"
 #include "harness/golden_store.h"
 #include "harness/image_compare.h"
+#include "harness/run_console.h"
 #include "harness/runner.h"
 #include "harness/suite.h"
 #include "tests/test_support.h"
@@ -153,6 +154,14 @@ TEST(Suite, FilterTakesSeveralGlobsSeparatedByBars) {
     EXPECT_FALSE(glob_match("a.b|c.*", "a.bc"));
     EXPECT_TRUE(glob_match("", "anything"));
     EXPECT_FALSE(glob_match("|", "x")) << "an empty alternative matches nothing but the empty name";
+    // `!GLOB` leaves out what it matches (issue 32: the approve command of one cause's 52 failures).
+    EXPECT_TRUE(glob_match("mobile.*|!*lut*", "mobile.a"));
+    EXPECT_FALSE(glob_match("mobile.*|!*lut*", "mobile.env_brdf=lut"));
+    EXPECT_FALSE(glob_match("mobile.*|!*lut*", "sampled.a"));
+    EXPECT_TRUE(glob_match("!*lut*", "sampled.a")) << "only exclusions: every other name";
+    EXPECT_TRUE(glob_match("a\\!b|!x", "a!b"));
+    EXPECT_EQ(select_tests(ci, "mobile.furnace.*|!*lut*", 0, 1).size() + select_tests(ci, "mobile.furnace.*lut*", 0, 1).size(),
+              furnaces);
     std::string err;
     const fs::path dir = temp_dir("repeats");
     try {
@@ -307,14 +316,17 @@ TEST(Gate, ShaderChangeFailsExactlyTheAffectedCiTestsAndBisectFollowsTheContract
         }
     }
     EXPECT_GE(failed, 20);
-    // -q keeps the summary and the one line that approves every failure, and names exactly them.
-    std::string all;
-    for (auto& t : r["tests"])
-        if (t["verdict"] == "fail") all += (all.empty() ? "" : "|") + t["name"].get<std::string>();
-    EXPECT_NE(out.find(fmt::format("approve all {} failures (after looking at them): {} bless --suite 'ci' --filter '{}'\n",
-                                   failed, printed_bin(), all)),
-              std::string::npos)
+    // -q keeps the summary and the one line that approves every failure: a short filter (issue 32:
+    // not every name spelt out) that selects exactly them.
+    std::smatch m;
+    ASSERT_TRUE(std::regex_search(out, m,
+                                  std::regex(fmt::format(R"(approve all {} failures \(after looking at them\): )", failed) +
+                                             std::regex_replace(printed_bin(), std::regex(R"([.^$|()\[\]{{}}*+?\\])"), R"(\$&)") +
+                                             R"( bless --suite 'ci' --filter '([^']+)'\n)")))
         << out;
+    const std::string all = m[1];
+    EXPECT_LT(all.size(), 200u) << all;
+    for (auto& t : r["tests"]) EXPECT_EQ(glob_match(all, t["name"]), t["verdict"] == "fail") << all << " and " << t["name"];
     EXPECT_NE(out.find(fmt::format("{} fail,", failed)), std::string::npos) << out;
 
     // Without -q, each failure says what failed, where (the sphere), what it did to the accuracy
@@ -470,4 +482,68 @@ TEST(ImageCompare, PerSphereErrorsLayoutAndSphereAtReadTheCoverage) {
     EXPECT_TRUE(per_sphere_errors(one, err).is_null()); // a single-sphere scene has no breakdown
     SphereCoverage many{cov.ids, std::vector<SphereCoverage::Sphere>(255, cov.spheres[0])};
     EXPECT_TRUE(sphere_layout(many).ids.empty()); // more spheres than the 8-bit map holds
+}
+
+// A change that fails 45 tests prints a few screens, not 315 lines (issue 32): on a terminal the
+// first failures print their details, the next their line, the rest only the progress; the summary
+// names the group with one short approve command.
+TEST(RunConsole, FortyFiveFailuresOfOneCausePrintUnderSixtyLines) {
+    json R = {{"suite", "ci"}, {"command", "iblcheck run --suite ci"}, {"total_s", 30.0}, {"tests", json::array()}};
+    for (int k = 0; k < 71; ++k) {
+        const bool fail = k < 45;
+        const std::string name = fmt::format("mobile.roughness_sweep.studio.{}storage=v{}", fail ? "mip_mapping=ue4," : "", k);
+        json t = {{"name", name}, {"verdict", fail ? "fail" : "pass"}, {"wall_s", 1.0}, {"accuracy", nullptr}};
+        if (fail) {
+            t["bless_command"] = "iblcheck bless --suite 'ci' --filter '" + name + "'";
+            t["comparisons"] = json::array(
+                {{{"kind", "baseline"},
+                  {"verdict", "fail"},
+                  {"checks",
+                   json::array({{{"metric", "flip.mean"}, {"status", "fail"}, {"message", "flip.mean 0.02 > 0.001 (+0.019)"}}})},
+                  {"worst_block", {{"x", 16}, {"y", 16}, {"flip", 0.2}, {"sphere", "metal r=0"}}}}});
+        }
+        R["tests"].push_back(t);
+    }
+    testing::internal::CaptureStdout();
+    ConsoleBudget budget;
+    for (size_t i = 0; i < R["tests"].size(); ++i) print_test_line(R["tests"][i], int(i + 1), R["tests"].size(), true, budget);
+    RunSummary s;
+    s.fail = 45;
+    s.pass = 26;
+    print_run_summary(R, s, 71, RunOptions{}, "ci");
+    const std::string out = testing::internal::GetCapturedStdout();
+    const size_t lines = size_t(std::count(out.begin(), out.end(), '\n'));
+    EXPECT_LT(lines, 60u) << out;
+    EXPECT_GT(lines, 15u) << out;
+    EXPECT_NE(out.find("45 tests did not pass, in 1 group"), std::string::npos) << out;
+    EXPECT_NE(
+        out.find("approve all 45 failures (after looking at them): iblcheck bless --suite 'ci' --filter '*mip_mapping=*'\n"),
+        std::string::npos)
+        << out;
+}
+
+// The nightly's History tab is not empty for whoever runs it as the README says (issue 32): a run
+// with --out and no --history appends to the suite's history file beside --out.
+TEST(Suite, NightlyAppendsToAHistoryBesideItsOutputByDefault) {
+    const Suite nightly = load_suite("nightly");
+    EXPECT_EQ(nightly.history, "nightly_history.jsonl");
+    RunOptions o;
+    o.out_dir = "runs/nightly/";
+    EXPECT_EQ(with_suite_history(o, nightly).history, fs::absolute("runs/nightly_history.jsonl").lexically_normal());
+    o.history = "mine.jsonl";
+    EXPECT_EQ(with_suite_history(o, nightly).history, "mine.jsonl") << "--history wins";
+    o = RunOptions{};
+    EXPECT_TRUE(with_suite_history(o, nightly).history.empty()) << "no --out: nothing written";
+    o.out_dir = "x";
+    EXPECT_TRUE(with_suite_history(o, load_suite("ci")).history.empty()) << "ci keeps none";
+    const fs::path dir = temp_dir("suite_history");
+    write_file(dir / "h.json",
+               R"({"suite": "h", "history": "/tmp/h.jsonl", "tests": [{"scene": "sphere", "method": "mobile"}]})");
+    try {
+        load_suite((dir / "h.json").string());
+        ADD_FAILURE() << "an absolute history path was accepted";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("history"), std::string::npos) << e.what();
+    }
+    fs::remove_all(dir);
 }

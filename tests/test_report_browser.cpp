@@ -198,3 +198,156 @@ TEST(ReportBrowser, CiReportWithOneFailureReadsInTheFirstScreenAndItsViewerWorks
     }
     fs::remove_all(dir);
 }
+
+// A change that fails 45 tests the same way (issue 32; one mip constant did so to the ci suite): the
+// first screen shows the group, its representative's image in the viewer and one short approve
+// command; the 44 others are folded, each opens its card; the page stays a few screens.
+TEST(ReportBrowser, CiReportWith45FailuresOfOneCauseShowsOneGroupInTheFirstScreen) {
+    if (!Browser::available()) GTEST_SKIP() << Browser::kChromium << " is not installed (Debian package chromium)";
+    const fs::path dir = testutil::temp_dir("browser_ci45");
+    const testutil::CiRun run = testutil::make_ci_run(dir / "run", 26, 45);
+    report::write_report(run.results, run.dir, run.dir);
+    {
+        Browser b(dir / "profile", 1440, 900);
+        b.open("file://" + (run.dir / "index.html").string(), kReady, 60);
+        expect_loaded(b);
+        const int height = b.eval("document.documentElement.scrollHeight").get<int>();
+        std::cout << "ci report (26 pass, 45 fail) at 1440x900: " << height << " px\n";
+        EXPECT_LT(height, 6000);
+        EXPECT_EQ(b.eval("document.querySelectorAll('section.group').length").get<int>(), 1);
+        EXPECT_EQ(b.eval("document.querySelector('section.group').getAttribute('data-members')").get<std::string>(), "45");
+        // One card open, its viewer drawn; the others folded.
+        EXPECT_EQ(b.eval("Array.from(document.querySelectorAll('section.test.s-fail')).filter(function(c){"
+                         "return c.getBoundingClientRect().height>0;}).length")
+                      .get<int>(),
+                  1);
+        EXPECT_EQ(body(b, "data-viewers-ready"), "1");
+        auto bottom = [&](const std::string& sel) {
+            return b.eval("document.querySelector(" + json(sel).dump() + ").getBoundingClientRect().bottom").get<double>();
+        };
+        EXPECT_LE(bottom("section.group h2.ghead"), 900);
+        EXPECT_LE(bottom("section.group .cmd.bless-group"), 900);
+        EXPECT_LE(b.eval("document.querySelector('section.group canvas.cv-img').getBoundingClientRect().top").get<double>() + 100,
+                  900);
+        // The group's command is short and names the shared option, not 45 names.
+        const std::string cmd =
+            b.eval("document.querySelector('section.group .cmd.bless-group code').textContent").get<std::string>();
+        EXPECT_EQ(cmd, "iblcheck bless --suite 'ci' --filter '*mip_mapping=*'");
+        const std::string all = b.eval("document.querySelector('.cmd.bless-all code').textContent").get<std::string>();
+        EXPECT_EQ(all, cmd);
+        // Unfolded, a member's tile opens its card and its viewer draws.
+        b.eval("document.querySelector('details.gmore').open=true");
+        auto [tx, ty] = b.centre_of("details.gmore .tile");
+        b.click(tx, ty);
+        ASSERT_TRUE(
+            b.wait_for("(function(){var t=document.querySelector('details.gmore .tile');var c=document.getElementById("
+                       "t.dataset.card);return !c.hidden && c.querySelector('.viewer').getAttribute('data-ready')==='1';})()"));
+        b.eval("document.querySelector('details.gmore').open=false;window.scrollTo(0,0)");
+        save(b.screenshot(false), "report_ci45_first_screen.png");
+        for (const std::string& e : b.errors()) ADD_FAILURE() << "page: " << e;
+    }
+    fs::remove_all(dir);
+}
+
+// A measured run (the nightly: no baselines, nothing failed; issue 32) shows its tests as a table in
+// the first screen, sorted by a click on accuracy, cost or drift since the last run in the history.
+TEST(ReportBrowser, MeasuredRunIsATableSortableByAccuracyCostAndDrift) {
+    if (!Browser::available()) GTEST_SKIP() << Browser::kChromium << " is not installed (Debian package chromium)";
+    const fs::path dir = testutil::temp_dir("browser_measured");
+    testutil::CiRun run = testutil::make_ci_run(dir / "run", 6, 0);
+    json last = {{"commit", "0123456789ab"}, {"date", "2026-11-22T03:00:00Z"}, {"suite", "ci"}, {"tests", json::object()}};
+    for (json& t : run.results["tests"]) {
+        t.erase("comparisons");
+        // Drift since the last run: test k was 0.2 + 0.001 k then; make test 2 jump by +50 %.
+        const double now = t["accuracy"]["flip_mean"].get<double>();
+        last["tests"][t["name"].get<std::string>()] = {
+            {"verdict", "pass"}, {"flip_mean", t["name"] == run.results["tests"][2]["name"] ? now / 1.5 : now}};
+    }
+    report::write_report(run.results, run.dir, run.dir, {last});
+    {
+        Browser b(dir / "profile", 1440, 900);
+        b.open("file://" + (run.dir / "index.html").string(), kReady);
+        expect_loaded(b);
+        const std::string table = "#tab-tests table.sortable";
+        EXPECT_LE(b.eval("document.querySelector('" + table + "').getBoundingClientRect().top").get<double>(), 600);
+        auto names = [&]() {
+            return b.eval("Array.from(document.querySelectorAll('" + table +
+                          " tbody tr')).map(function(r){return "
+                          "r.getAttribute('data-name');})");
+        };
+        auto sort_by = [&](int column) {
+            auto [x, y] = b.centre_of(fmt::format("{} th:nth-child({})", table, column));
+            b.click(x, y);
+        };
+        const json& tests = run.results["tests"];
+        sort_by(5); // drift %, ascending: test 2's +50 % last
+        EXPECT_EQ(names()[5], tests[2]["name"]);
+        sort_by(5); // again: descending, test 2 first
+        EXPECT_EQ(names()[0], tests[2]["name"]);
+        sort_by(4); // FLIP vs the truth ascending: 0.2 + 0.001 k in test order
+        for (int k = 0; k < 6; ++k) EXPECT_EQ(names()[k], tests[k]["name"]) << k;
+        sort_by(6); // SPIR-V instr/px: 6276 + k, ascending
+        EXPECT_EQ(names()[0], tests[0]["name"]);
+        EXPECT_EQ(b.eval("document.querySelector('" + table + " tbody tr td:nth-child(5)').textContent").get<std::string>(),
+                  "+0.0");
+        for (const std::string& e : b.errors()) ADD_FAILURE() << "page: " << e;
+    }
+    fs::remove_all(dir);
+}
+
+// Under a bright sun one exposure blows out half the spheres (issue 32): the viewer's false colour
+// paints each pixel by its stop of luminance (the same band the C++ computes from the float data),
+// and the exposure per sphere leaves no sphere blown out. Display only: the figures stay.
+TEST(ReportBrowser, FalseColourAndExposurePerSphereShowWhatOneExposureBlowsOut) {
+    if (!Browser::available()) GTEST_SKIP() << Browser::kChromium << " is not installed (Debian package chromium)";
+    const fs::path dir = testutil::temp_dir("browser_false");
+    const testutil::CiRun run = testutil::make_ci_run(dir / "run", 3, 1);
+    report::write_report(run.results, run.dir, run.dir);
+    {
+        Browser b(dir / "profile", 1440, 900);
+        b.open("file://" + (run.dir / "index.html").string(), kReady);
+        expect_loaded(b);
+        const std::string card = "section.test.s-fail";
+        auto mode = [&](const std::string& m) {
+            b.eval("(function(){var s=document.querySelector('" + card + " select.dmode');s.value='" + m +
+                   "';s.dispatchEvent(new Event('change'));})()");
+        };
+        auto [x0, y0] = b.centre_of(card + " button.ev-0");
+        b.click(x0, y0);
+        mode("false");
+        EXPECT_FALSE(b.eval("document.querySelector('" + card + " .fclegend').hidden").get<bool>());
+        const json palette = b.eval("window.iblcheckFalseColour");
+        ASSERT_EQ(palette.size(), 15u);
+        int checked = 0;
+        for (int sphere = 0; sphere < run.width / 48; sphere += 2) {
+            const int px = 24 + 48 * sphere, py = 24;
+            const cv::Vec3f c = run.failing_test.at<cv::Vec3f>(py, px);
+            const double L = 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+            if (!(L > 0)) continue;
+            const int band = int(std::floor(std::log2(L / 0.18) + 0.5)) + 7;
+            const json want = band < 0 ? json({0, 0, 0}) : band > 14 ? json({255, 255, 255}) : palette[band];
+            const json got = b.eval(fmt::format("Array.from(document.querySelector('{} canvas.cv-img').getContext('2d')"
+                                                ".getImageData({},{},1,1).data).slice(0,3)",
+                                                card, px, py));
+            EXPECT_EQ(got, want) << "sphere " << sphere << " L " << L;
+            ++checked;
+        }
+        EXPECT_GE(checked, 5);
+        save(b.screenshot(false), "report_false_colour.png");
+        // Blown-out pixels (every channel at 254 or more): some at +6 EV with one exposure, none per sphere.
+        const std::string blown = "(function(){var c=document.querySelector('" + card +
+                                  " canvas.cv-img'),d=c.getContext('2d').getImageData(0,0,c.width,c.height).data,n=0;"
+                                  "for(var i=0;i<d.length;i+=4)if(d[i]>=254&&d[i+1]>=254&&d[i+2]>=254)n++;return n;})()";
+        mode("exp");
+        b.eval("(function(){var e=document.querySelector('" + card +
+               " input.ev');e.value=6;e.dispatchEvent(new Event('input'));})()");
+        EXPECT_GT(b.eval(blown).get<int>(), 100);
+        mode("sphere");
+        auto [ax, ay] = b.centre_of(card + " button.ev-auto");
+        b.click(ax, ay);
+        EXPECT_EQ(b.eval(blown).get<int>(), 0);
+        save(b.screenshot(false), "report_exposure_per_sphere.png");
+        for (const std::string& e : b.errors()) ADD_FAILURE() << "page: " << e;
+    }
+    fs::remove_all(dir);
+}

@@ -48,7 +48,7 @@ void register_run(CLI::App& app, int& exit_code) {
     static std::vector<std::string> findings;
     auto* r = app.add_subcommand("run", "Run a suite: render, compare with goldens, verdicts, report");
     r->add_option("--suite", run.suite, "Suite name (harness/suites) or a .json path")->capture_default_str();
-    r->add_option("--filter", run.filter, "Glob on test names");
+    r->add_option("--filter", run.filter, "Glob on test names (globs separated by '|'; !GLOB leaves out what it matches)");
     r->add_option("--shader", run.shader, "A team's IBL shading file for every mobile test (docs/SHADER_CONTRACT.md)");
     r->add_option("--shard", shard, "INDEX/COUNT: run one shard (GTest convention, 0-based)");
     r->add_option("--jobs,-j", run.jobs, "Tests in parallel (default: the suite's)");

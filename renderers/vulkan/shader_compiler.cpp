@@ -142,6 +142,19 @@ std::string shader_tree_hash() {
     return h.hex();
 }
 
+std::map<std::string, std::string> shader_file_hashes() {
+    std::map<std::string, std::string> out;
+    const fs::path dir = shader_dir();
+    if (!fs::is_directory(dir)) throw EnvironmentError(dir.string() + ": shader folder not found");
+    for (const auto& e : fs::recursive_directory_iterator(dir))
+        if (e.is_regular_file()) {
+            Fnv1a64 h;
+            h.update(read_text(e.path()));
+            out[fs::relative(e.path(), dir).generic_string()] = h.hex();
+        }
+    return out;
+}
+
 void check_ibl_shade_file(const fs::path& file) {
     std::error_code ec;
     if (!fs::exists(file, ec))

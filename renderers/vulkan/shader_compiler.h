@@ -57,6 +57,9 @@ CompiledShader compile_shader_file(const std::filesystem::path& path, const Defi
 
 // A hash over every .glsl/.comp file in shader_dir(): the "shader source hash" of provenance.
 std::string shader_tree_hash();
+// The content hash of each file of the shader folder, by its path relative to it: a sidecar keeps
+// them so the report can say which files changed since a baseline was blessed (issue 32).
+std::map<std::string, std::string> shader_file_hashes();
 
 // The include name a pass uses for the team's shading file (CompileOptions::ibl_shade).
 inline constexpr const char* kIblShadeInclude = "ibl_shade_user.glsl";
