@@ -11,10 +11,12 @@
 
 #include "harness/common/errors.h"
 #include "harness/common/output_files.h"
+#include "harness/common/profile.h"
 #include "provenance.h"
 #include "reports/report_writer.h"
 #include "run_console.h"
 #include "run_files.h"
+#include "run_profile.h"
 #include "test_run.h"
 #include "verdict.h"
 #include "worker.h"
@@ -109,6 +111,7 @@ void record_run(RunSummary& s, const std::string& suite, const RunOptions& o, Po
 // the run folder is swapped in as --out once all of it is written.
 void write_outputs(const json& R, const RunOptions& o, RunFolder& folder) {
     const fs::path& dir = folder.dir();
+    ProfileStage stage("results_and_report");
     if (!dir.empty()) write_json_atomically(dir / "results.json", R);
     if (!o.json.empty()) write_json_atomically(o.json, R);
     if (!o.junit.empty()) write_junit(R, o.junit);
@@ -156,6 +159,8 @@ RunSummary run_suite(const RunOptions& o) {
     jobs = std::max(1, std::min<int>(jobs, int(tests.size())));
     check_output_options(o, suite);
     RunFolder folder(o.out_dir, o.force);
+    profile::enable(o.profile);
+    profile::take(); // this thread's stages before the run (none counted twice)
 
     const auto t0 = std::chrono::steady_clock::now();
     PoolOutcome pool = run_tests(tests, o, folder.dir(), store, jobs, suite.timing_repeats);
@@ -169,6 +174,9 @@ RunSummary run_suite(const RunOptions& o) {
     }
     print_run_summary(s.results, s, tests.size(), o, tests[0].suite_arg,
                       tests[0].shader_arg); // -q drops the per-test lines, never this summary
+    if (o.profile)
+        print_profile(s.results, profile::take(), std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
+                      jobs);
     return s;
 }
 

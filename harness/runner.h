@@ -35,6 +35,7 @@ struct RunOptions {
     bool force = false;     // replace an earlier run's --out, overwrite --json and --junit files
     bool report = true;     // write index.html when out_dir is set
     bool stability = false; // measure determinism, noise floors and margins for every test
+    bool profile = false;   // print where the time went (run_profile.h); each test's results gain "profile"
 };
 
 struct RunSummary {

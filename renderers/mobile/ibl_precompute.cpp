@@ -8,6 +8,7 @@
 #include "astc_storage.h"
 #include "env_layout.h"
 #include "harness/common/errors.h"
+#include "harness/common/profile.h"
 #include "mip_chain.h"
 #include "renderers/mobile/descriptor_types.h"
 #include "renderers/mobile/push_constants.h"
@@ -65,6 +66,7 @@ VkFormat storage_format(const std::string& storage, bool native_r11g11b10) {
 // pass samples. The encode and decode times are precompute passes (on the CPU).
 vk::Image astc_round_trip(vk::Context& ctx, const vk::Image& encoded, const PrecomputeSettings& s, float rgbm_range,
                           std::vector<PassTiming>& timings) {
+    ProfileStage stage("astc_encode");
     AstcFormat format;
     format.profile = s.storage == "astc_hdr" ? AstcProfile::hdr : AstcProfile::ldr_rgbm;
     format.block = astc_block_from_option(s.astc_block);
@@ -374,6 +376,7 @@ std::shared_ptr<IblResources> precompute_cached(GpuSession& gpu, const Environme
         return e->ibl;
     }
     cached = false;
+    ProfileStage stage("precompute");
     auto e = std::make_shared<Entry>();
     e->ibl = std::make_shared<IblResources>(run_precompute(gpu, env, s, e->timings));
     timings.insert(timings.end(), e->timings.begin(), e->timings.end());

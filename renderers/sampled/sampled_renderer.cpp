@@ -3,6 +3,7 @@
 #include "sampled_renderer.h"
 
 #include "harness/common/errors.h"
+#include "harness/common/profile.h"
 #include "renderers/mobile/gpu_scene.h"
 #include "renderers/mobile/ibl_precompute.h"
 #include "renderers/mobile/push_constants.h"
@@ -31,6 +32,7 @@ RenderResult render_sampled(GpuSession& gpu, const Environment& env, const TestS
                                                  VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
                                                  VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
     const vk::Defines defines = glsl_defines(shader_selections(o, "sampled")); // mip_clamp
+    ProfileStage stage("shading");
     const auto& shade = gpu.pipeline("shade_sampled.comp", defines, types, sizeof(SampledPush));
     vk::Context& ctx = gpu.ctx();
     vk::Buffer scene_buf = upload_scene(ctx, scene);

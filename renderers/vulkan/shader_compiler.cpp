@@ -17,6 +17,7 @@
 #include "fp16_pass_hash.h" // generated: IBLCHECK_FP16_PASS_HASH
 #include "harness/common/errors.h"
 #include "harness/common/hash.h"
+#include "harness/common/profile.h"
 #include "spirv_cost.h"
 
 namespace fs = std::filesystem;
@@ -316,6 +317,7 @@ void apply_passes(std::vector<uint32_t>& spirv, const CompileOptions& options, c
 }
 
 CompiledShader compile_stage_file(const fs::path& path_in, Stage stage, const Defines& defines, const CompileOptions& options) {
+    ProfileStage profile_stage("spirv_compile_or_cache");
     const fs::path path = fs::weakly_canonical(path_in);
     if (!options.ibl_shade.empty()) check_ibl_shade_file(options.ibl_shade); // before its text is hashed
     CompiledShader out;
