@@ -6,6 +6,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <map>
 #include <mutex>
 #include <thread>
 
@@ -13,6 +14,7 @@
 #include "harness/common/output_files.h"
 #include "harness/common/profile.h"
 #include "provenance.h"
+#include "renderers/renderer.h"
 #include "reports/report_writer.h"
 #include "run_console.h"
 #include "run_files.h"
@@ -35,12 +37,13 @@ struct PoolOutcome {
     bool shader_error = false;
 };
 
-// The tests on `jobs` worker threads, each with its own renderer, taking the next test as it
-// finishes one; a line per test as it finishes unless quiet.
+// The tests on `jobs` worker threads, each with its own renderer, taking the next batch of tests as
+// it finishes one; a line per test as it finishes unless quiet. Results stay in suite order.
 PoolOutcome run_tests(const std::vector<TestCase>& tests, const RunOptions& o, const fs::path& out_dir, const GoldenStore& store,
                       int jobs, int timing_repeats) {
     const int flip_threads = jobs > 1 ? 1 : 0;
     std::vector<json> results(tests.size());
+    const std::vector<std::vector<size_t>> batches = precompute_batches(tests);
     std::atomic<size_t> next{0};
     std::atomic<int> done{0};
     std::atomic<bool> shader_error{false};
@@ -51,24 +54,25 @@ PoolOutcome run_tests(const std::vector<TestCase>& tests, const RunOptions& o, c
     auto work = [&] {
         try {
             Worker w(o.device);
-            for (size_t i; (i = next++) < tests.size();) {
-                bool se = false;
-                TestCase tc = tests[i];
-                if (o.stability) tc.stability.enabled = true;
-                results[i] = run_test(tc, w, store, out_dir, flip_threads, timing_repeats, se);
-                if (se) shader_error = true;
-                int n = ++done;
-                if (!o.quiet) {
-                    std::lock_guard lock(print_mutex);
-                    print_test_line(results[i], n, tests.size(), interactive);
+            for (size_t b; (b = next++) < batches.size();)
+                for (size_t i : batches[b]) {
+                    bool se = false;
+                    TestCase tc = tests[i];
+                    if (o.stability) tc.stability.enabled = true;
+                    results[i] = run_test(tc, w, store, out_dir, flip_threads, timing_repeats, se);
+                    if (se) shader_error = true;
+                    int n = ++done;
+                    if (!o.quiet) {
+                        std::lock_guard lock(print_mutex);
+                        print_test_line(results[i], n, tests.size(), interactive);
+                    }
                 }
-            }
             std::lock_guard lock(driver_mutex);
             if (json d = w.renderer.driver_json(); !d.empty()) driver = d;
         } catch (...) { // escaping the thread, it would abort the process (SIGABRT) with no results
             std::lock_guard lock(driver_mutex);
             if (!failure) failure = std::current_exception();
-            next = tests.size();
+            next = batches.size();
         }
     };
     std::vector<std::thread> pool;
@@ -142,6 +146,25 @@ void check_output_options(const RunOptions& o, const Suite& suite) {
 }
 
 } // namespace
+
+std::vector<std::vector<size_t>> precompute_batches(const std::vector<TestCase>& tests) {
+    std::vector<std::vector<size_t>> batches;
+    std::map<std::string, size_t> batch_of;
+    for (size_t i = 0; i < tests.size(); ++i) {
+        std::string key;
+        try {
+            key = precompute_share_key(tests[i].spec);
+        } catch (const std::exception&) {
+            key = "unshared;" + std::to_string(i);
+        }
+        if (key.empty()) key = "unshared;" + std::to_string(i); // the CPU truth: nothing to share
+        auto [it, fresh] = batch_of.emplace(key, batches.size());
+        if (fresh) batches.emplace_back();
+        batches[it->second].push_back(i);
+    }
+    std::stable_sort(batches.begin(), batches.end(), [](const auto& a, const auto& b) { return a.size() > b.size(); });
+    return batches;
+}
 
 int RunSummary::exit_code() const {
     if (error) return kExitError;

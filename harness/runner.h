@@ -47,4 +47,11 @@ struct RunSummary {
 
 RunSummary run_suite(const RunOptions& options);
 
+// `tests` (indices) in batches that share a GPU precompute (renderer.h: precompute_share_key),
+// largest first: a worker takes a whole batch, so its session computes that precompute once.
+// Handed out a test at a time, the two workers each computed most of them (the 71 ci tests: ~47
+// precomputes where 30 differ). A test whose options are bad gets a batch of its own (it fails
+// when it runs), and so does each CPU-truth test (nothing to share).
+std::vector<std::vector<size_t>> precompute_batches(const std::vector<TestCase>& tests);
+
 } // namespace iblcheck

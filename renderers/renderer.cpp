@@ -68,6 +68,12 @@ void validate_spec(const TestSpec& spec) {
     build_scene(spec.scene, spec.options); // unknown scene or bad material option: UsageError
 }
 
+std::string precompute_share_key(const TestSpec& spec) {
+    if (spec.method == "mobile") return precompute_key(spec.env, mobile_precompute_settings(spec));
+    if (spec.method == "sampled") return precompute_key(spec.env, sampled_precompute_settings(spec));
+    return "";
+}
+
 Renderer::Renderer(vk::ContextOptions options) : options_(std::move(options)) {}
 Renderer::~Renderer() = default;
 

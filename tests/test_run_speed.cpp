@@ -7,10 +7,14 @@
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
+#include <map>
+#include <set>
 #include <string>
 
 #include "harness/common/profile.h"
 #include "harness/runner.h"
+#include "harness/suite.h"
+#include "renderers/renderer.h"
 #include "tests/furnace_store.h"
 #include "tests/test_support.h"
 
@@ -103,4 +107,67 @@ TEST(Profile, RunPrintsStagesAndEachTestRecordsThem) {
     o.quiet = true;
     const RunSummary plain = run_suite(o);
     EXPECT_FALSE(plain.results["tests"][0].contains("profile"));
+}
+
+// The ci suite's tests in batches that share a precompute: every test once, one key per batch and
+// no key in two batches; the options that only change the shading (dominant_dir, normalization,
+// shading=fragment, another scene) share the default's batch, a storage or mip curve does not.
+TEST(SharedPrecompute, CiTestsAreBatchedByTheirPrecompute) {
+    const std::vector<TestCase> tests = load_suite("ci").tests;
+    const auto batches = precompute_batches(tests);
+    std::set<size_t> seen;
+    std::set<std::string> keys;
+    std::map<std::string, size_t> batch_of;
+    for (size_t b = 0; b < batches.size(); ++b) {
+        ASSERT_FALSE(batches[b].empty());
+        const std::string key = precompute_share_key(tests[batches[b][0]].spec);
+        EXPECT_TRUE(keys.insert(key).second) << "two batches share " << key;
+        for (size_t i : batches[b]) {
+            EXPECT_TRUE(seen.insert(i).second) << tests[i].name << " in two batches";
+            EXPECT_EQ(precompute_share_key(tests[i].spec), key) << tests[i].name;
+            batch_of[tests[i].name] = b;
+        }
+        if (b > 0) {
+            EXPECT_LE(batches[b].size(), batches[b - 1].size()); // largest first
+        }
+    }
+    EXPECT_EQ(seen.size(), tests.size());
+    const size_t studio = batch_of.at("mobile.roughness_sweep.studio.default");
+    for (const char* same :
+         {"mobile.roughness_sweep.studio.dominant_dir=lagarde", "mobile.roughness_sweep.studio.normalization=ue4",
+          "mobile.roughness_sweep.studio.shading=fragment", "mobile.sphere.studio.default"})
+        EXPECT_EQ(batch_of.at(same), studio) << same;
+    for (const char* other : {"mobile.roughness_sweep.studio.storage=rgbm8", "mobile.roughness_sweep.studio.mip_mapping=origin",
+                              "mobile.roughness_sweep.sky_sun.default", "sampled.roughness_sweep.studio.samples=64"})
+        EXPECT_NE(batch_of.at(other), studio) << other;
+    EXPECT_LT(batches.size(), tests.size()); // the sharing is real (71 tests, 35 precomputes on 2026-11-26)
+}
+
+// Two workers on tests that interleave two precomputes, the first two tests sharing one: each is
+// computed once (a render that reused it says so in its provenance). Handed out a test at a time,
+// the two workers took the first two tests and both computed the first precompute.
+TEST(SharedPrecompute, TwoWorkersComputeEachPrecomputeOnce) {
+    const char* suite = R"({
+  "suite": "mini",
+  "defaults": {"env": "constant:1",
+               "baseline_tolerances": {"flip.mean": {"max": 0.001}, "ssim.mean": {"min": 0.999}},
+               "reference_band": {"flip.mean": {"below": 0.2, "above": 0.1, "abs": 0.0}}},
+  "tests": [{"scene": "furnace", "method": "mobile", "variants": [{}, {"dominant_dir": "lagarde"}, {"storage": "rgbm8"},
+            {"storage": "rgbm8", "dominant_dir": "lagarde"}, {"normalization": "ue4"}, {"storage": "rgbm8", "normalization": "ue4"}]}]
+})";
+    FurnaceStore store("shared_precompute", suite);
+    ASSERT_EQ(store.bless_all(), kExitPass);
+    RunOptions o;
+    o.suite = store.suite.string();
+    o.goldens = store.goldens;
+    o.quiet = true;
+    o.jobs = 2;
+    const RunSummary s = run_suite(o);
+    ASSERT_EQ(s.results["tests"].size(), 6u);
+    int computed = 0;
+    for (const json& t : s.results["tests"]) {
+        EXPECT_EQ(t["verdict"], "pass") << t["name"] << ": " << t["message"];
+        computed += t["provenance"]["precompute_cached"].get<bool>() ? 0 : 1;
+    }
+    EXPECT_EQ(computed, 2);
 }

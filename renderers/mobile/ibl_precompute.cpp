@@ -356,14 +356,17 @@ IblResources run_precompute(GpuSession& gpu, const Environment& env, const Preco
     return r;
 }
 
+std::string precompute_key(const std::string& env_id, const PrecomputeSettings& s) {
+    return "ibl;" + env_id + ";" + std::to_string(s.cube_size) + ";" + std::to_string(s.mips) + ";" +
+           std::to_string(s.prefilter_samples) + ";" + s.mip_mapping + ";" + s.storage + ";" + std::to_string(s.rgbm_range) +
+           ";" + s.astc_block + ";" + s.env_layout + ";" + std::to_string(s.prefiltered) + ";" + std::to_string(s.lut) + ";" +
+           std::to_string(s.lut_size) + ";" + std::to_string(s.lut_samples) + ";" + std::to_string(s.irradiance_cube) + ";" +
+           std::to_string(s.irradiance_size) + ";" + std::to_string(s.env_rotation_deg);
+}
+
 std::shared_ptr<IblResources> precompute_cached(GpuSession& gpu, const Environment& env, const PrecomputeSettings& s,
                                                 std::vector<PassTiming>& timings, bool& cached) {
-    std::string key = "ibl;" + env.content_hash + ";" + std::to_string(s.cube_size) + ";" + std::to_string(s.mips) + ";" +
-                      std::to_string(s.prefilter_samples) + ";" + s.mip_mapping + ";" + s.storage + ";" +
-                      std::to_string(s.rgbm_range) + ";" + s.astc_block + ";" + s.env_layout + ";" +
-                      std::to_string(s.prefiltered) + ";" + std::to_string(s.lut) + ";" + std::to_string(s.lut_size) + ";" +
-                      std::to_string(s.lut_samples) + ";" + std::to_string(s.irradiance_cube) + ";" +
-                      std::to_string(s.irradiance_size) + ";" + std::to_string(s.env_rotation_deg);
+    const std::string key = precompute_key(env.content_hash, s);
     // No shader hash in the key: the session's pipelines are cached by name and defines too, so a
     // session renders with the sources it first compiled either way.
     struct Entry {

@@ -188,6 +188,12 @@ nlohmann::json fragment_provenance(const ShadingInputs& in, double texture_fetch
 
 } // namespace
 
+PrecomputeSettings mobile_precompute_settings(const TestSpec& spec) {
+    PrecomputeSettings ps = read_mobile_options(spec.options).ps;
+    if (!spec.shader.empty()) ps.lut = true; // as render_mobile: the contract always binds the DFG LUT
+    return ps;
+}
+
 RenderResult render_mobile(GpuSession& gpu, const Environment& env, const TestSpec& spec) {
     const OptionMap& o = spec.options;
     int width = 0, height = 0;

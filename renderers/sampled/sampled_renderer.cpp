@@ -12,15 +12,20 @@
 
 namespace iblcheck {
 
+PrecomputeSettings sampled_precompute_settings(const TestSpec& spec) {
+    PrecomputeSettings ps;
+    ps.cube_size = uint32_t(spec.options.get_int("cube_size", 256));
+    ps.prefiltered = false;
+    ps.env_rotation_deg = float(spec.options.get_double("env_rotation", 0.0));
+    return ps;
+}
+
 RenderResult render_sampled(GpuSession& gpu, const Environment& env, const TestSpec& spec) {
     const OptionMap& o = spec.options;
     int width = 0, height = 0;
     Scene scene = scene_for(spec, width, height);
 
-    PrecomputeSettings ps;
-    ps.cube_size = uint32_t(o.get_int("cube_size", 256));
-    ps.prefiltered = false;
-    ps.env_rotation_deg = float(o.get_double("env_rotation", 0.0));
+    const PrecomputeSettings ps = sampled_precompute_settings(spec);
     int samples = o.get_int("samples", 64);
     if (samples < 1 || samples > 65536) throw UsageError("option 'samples' must be in 1..65536");
 
