@@ -6,7 +6,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <set>
 #include <string>
@@ -14,7 +16,10 @@
 #include "harness/common/profile.h"
 #include "harness/runner.h"
 #include "harness/suite.h"
+#include "renderers/environments/environment.h"
+#include "renderers/mobile/precompute_store.h"
 #include "renderers/renderer.h"
+#include "renderers/vulkan/shader_compiler.h"
 #include "tests/furnace_store.h"
 #include "tests/test_support.h"
 
@@ -162,7 +167,9 @@ TEST(SharedPrecompute, TwoWorkersComputeEachPrecomputeOnce) {
     o.goldens = store.goldens;
     o.quiet = true;
     o.jobs = 2;
+    setenv("IBLCHECK_PRECOMPUTE_CACHE", "0", 1); // the count is of this run's precomputes, none from disk
     const RunSummary s = run_suite(o);
+    unsetenv("IBLCHECK_PRECOMPUTE_CACHE");
     ASSERT_EQ(s.results["tests"].size(), 6u);
     int computed = 0;
     for (const json& t : s.results["tests"]) {
@@ -170,4 +177,98 @@ TEST(SharedPrecompute, TwoWorkersComputeEachPrecomputeOnce) {
         computed += t["provenance"]["precompute_cached"].get<bool>() ? 0 : 1;
     }
     EXPECT_EQ(computed, 2);
+}
+
+namespace {
+
+// A render of `spec` with a fresh renderer (no session cache) and the precompute store at `store`
+// ("0": off).
+RenderResult fresh_render(const TestSpec& spec, const std::string& store) {
+    setenv("IBLCHECK_PRECOMPUTE_CACHE", store.c_str(), 1);
+    Renderer r;
+    RenderResult out = r.render(spec);
+    unsetenv("IBLCHECK_PRECOMPUTE_CACHE");
+    return out;
+}
+
+bool same_pixels(const cv::Mat& a, const cv::Mat& b) {
+    return a.size() == b.size() && a.type() == b.type() && std::memcmp(a.data, b.data, a.total() * a.elemSize()) == 0;
+}
+
+TestSpec furnace_spec(const std::map<std::string, std::string>& options) {
+    TestSpec s;
+    s.scene = "furnace";
+    s.method = "mobile";
+    s.env = "studio";
+    s.options.set("cube_size", "32");
+    for (const auto& [k, v] : options) s.options.set(k, v);
+    return s;
+}
+
+} // namespace
+
+// A precompute stored on disk renders bit-identically to one computed now, for every storage format
+// the store holds (RGBA16F, RGBM8, R11G11B10, ASTC's decoded texels), a 2D layout, the LUT and the
+// irradiance cube; a damaged entry is computed again, never read.
+TEST(PrecomputeStore, StoredPrecomputeRendersBitIdenticallyAndADamagedEntryIsRecomputed) {
+    const fs::path dir = temp_dir("precompute_store");
+    for (const auto& options :
+         std::vector<std::map<std::string, std::string>>{{},
+                                                         {{"storage", "rgbm8"}},
+                                                         {{"storage", "r11g11b10"}},
+                                                         {{"storage", "astc_hdr"}},
+                                                         {{"env_layout", "octahedral"}},
+                                                         {{"env_brdf", "lut"}, {"diffuse", "irradiance_cube"}}}) {
+        const TestSpec spec = furnace_spec(options);
+        const std::string what = spec.options.canonical();
+        const RenderResult computed = fresh_render(spec, "0");
+        const RenderResult stored = fresh_render(spec, dir.string()); // computes it and stores it
+        const RenderResult loaded = fresh_render(spec, dir.string()); // reads it
+        EXPECT_FALSE(stored.provenance["precompute_cached"].get<bool>()) << what;
+        EXPECT_TRUE(loaded.provenance["precompute_cached"].get<bool>()) << what;
+        EXPECT_TRUE(same_pixels(computed.image, stored.image)) << what;
+        EXPECT_TRUE(same_pixels(computed.image, loaded.image)) << what;
+        EXPECT_EQ(computed.provenance["rgbm"], loaded.provenance["rgbm"]) << what;
+        EXPECT_EQ(computed.provenance["texture"], loaded.provenance["texture"]) << what;
+    }
+    // Every entry cut in half: each render computes its precompute again, and renders the same.
+    for (const auto& e : fs::directory_iterator(dir)) fs::resize_file(e.path(), fs::file_size(e.path()) / 2);
+    const TestSpec spec = furnace_spec({{"storage", "rgbm8"}});
+    const RenderResult again = fresh_render(spec, dir.string());
+    EXPECT_FALSE(again.provenance["precompute_cached"].get<bool>());
+    EXPECT_TRUE(same_pixels(again.image, fresh_render(spec, "0").image));
+    fs::remove_all(dir);
+}
+
+// The entry's key changes with every input: the environment's pixels, a setting, a pass shader's
+// include (not only the pass's own file), llvmpipe's CPU class; the same inputs give the same key.
+TEST(PrecomputeStore, AChangedInputMisses) {
+    GpuSession gpu;
+    const Environment studio = load_environment("studio"), sky = load_environment("sky_sun");
+    PrecomputeSettings s;
+    const std::string key = precompute_store_key(gpu, studio, s);
+    EXPECT_EQ(precompute_store_key(gpu, studio, s), key);
+    EXPECT_NE(precompute_store_key(gpu, sky, s), key);
+    PrecomputeSettings other = s;
+    other.storage = "rgbm8";
+    EXPECT_NE(precompute_store_key(gpu, studio, other), key);
+    other = s;
+    other.prefilter_samples = 128;
+    EXPECT_NE(precompute_store_key(gpu, studio, other), key);
+
+    // A copy of the shaders whose brdf.glsl (included by prefilter_ggx.comp) gained a comment.
+    const fs::path shaders = temp_dir("precompute_store_shaders");
+    fs::copy(vk::shader_dir(), shaders, fs::copy_options::recursive);
+    std::ofstream(shaders / "brdf.glsl", std::ios::app) << "\n// edited\n";
+    setenv("IBLCHECK_SHADER_DIR", shaders.c_str(), 1);
+    const std::string edited = precompute_store_key(gpu, studio, s);
+    unsetenv("IBLCHECK_SHADER_DIR");
+    fs::remove_all(shaders);
+    EXPECT_NE(edited, key);
+
+    // Another CPU class (llvmpipe generates other code for it).
+    setenv("GALLIUM_OVERRIDE_CPU_CAPS", "sse4.1", 1);
+    const std::string other_cpu = precompute_store_key(gpu, studio, s);
+    unsetenv("GALLIUM_OVERRIDE_CPU_CAPS");
+    EXPECT_NE(other_cpu, key);
 }

@@ -10,6 +10,7 @@
 #include "harness/common/errors.h"
 #include "harness/common/profile.h"
 #include "mip_chain.h"
+#include "precompute_store.h"
 #include "renderers/mobile/descriptor_types.h"
 #include "renderers/mobile/push_constants.h"
 #include "renderers/option_table.h"
@@ -379,9 +380,18 @@ std::shared_ptr<IblResources> precompute_cached(GpuSession& gpu, const Environme
         return e->ibl;
     }
     cached = false;
-    ProfileStage stage("precompute");
     auto e = std::make_shared<Entry>();
-    e->ibl = std::make_shared<IblResources>(run_precompute(gpu, env, s, e->timings));
+    // A precompute an earlier run stored on disk (precompute_store.h: keyed by every input), else
+    // computed now and stored.
+    const std::string disk_key = precompute_store_key(gpu, env, s);
+    if (std::optional<IblResources> stored = load_precompute(gpu.ctx(), disk_key, e->timings)) {
+        cached = true;
+        e->ibl = std::make_shared<IblResources>(std::move(*stored));
+    } else {
+        ProfileStage stage("precompute");
+        e->ibl = std::make_shared<IblResources>(run_precompute(gpu, env, s, e->timings));
+        save_precompute(gpu.ctx(), disk_key, *e->ibl, e->timings);
+    }
     timings.insert(timings.end(), e->timings.begin(), e->timings.end());
     gpu.store(key, e);
     return e->ibl;

@@ -154,6 +154,13 @@ void check_ibl_shade_file(const fs::path& file) {
         throw InputError(file.string() + ": no function `vec3 ibl_shade(IblSurface s, IblInputs ibl)` (docs/SHADER_CONTRACT.md)");
 }
 
+std::string file_tree_hash(const fs::path& file) {
+    Fnv1a64 h;
+    std::set<fs::path> seen;
+    hash_sources(fs::weakly_canonical(file), h, seen, {});
+    return h.hex();
+}
+
 std::string ibl_shade_hash(const fs::path& file) {
     check_ibl_shade_file(file);
     Fnv1a64 h;
