@@ -272,3 +272,18 @@ TEST(PrecomputeStore, AChangedInputMisses) {
     unsetenv("GALLIUM_OVERRIDE_CPU_CAPS");
     EXPECT_NE(other_cpu, key);
 }
+
+// `--version` reads the commit from iblcheck_commit.txt beside the binary (written at every build),
+// so a bisect step whose commit (or a shader edit's dirty state) changed relinks nothing; compiled
+// in, it recompiled version.cpp and relinked the tool at every step. Without the file: "unknown".
+TEST(BisectStep, VersionReadsTheCommitBesideTheBinary) {
+    const fs::path dir = temp_dir("version_file");
+    for (const char* f : {"iblcheck", "libiblcheck_oiio.so"}) fs::copy(fs::path(IBLCHECK_BINARY_DIR) / f, dir / f);
+    std::string out;
+    ASSERT_EQ(run_command((dir / "iblcheck").string() + " --version", out), 0) << out;
+    EXPECT_NE(out.find("(commit unknown,"), std::string::npos) << out;
+    write_file(dir / "iblcheck_commit.txt", "0123456789ab-dirty\n");
+    ASSERT_EQ(run_command((dir / "iblcheck").string() + " --version", out), 0) << out;
+    EXPECT_NE(out.find("(commit 0123456789ab-dirty,"), std::string::npos) << out;
+    fs::remove_all(dir);
+}
