@@ -88,11 +88,14 @@ TEST(Profile, RunPrintsStagesAndEachTestRecordsThem) {
     ASSERT_EQ(store.bless_all(), kExitPass);
     const fs::path out = store.dir / "out";
     std::string text;
-    const std::string cmd = std::string(IBLCHECK_BINARY_DIR) + "/iblcheck run --suite " + store.suite.string() + " --goldens " +
+    // An empty precompute store of its own, so the precompute and the ASTC encode run (and are stored).
+    const std::string cmd = "IBLCHECK_PRECOMPUTE_CACHE=" + (store.dir / "precompute").string() + " " +
+                            std::string(IBLCHECK_BINARY_DIR) + "/iblcheck run --suite " + store.suite.string() + " --goldens " +
                             store.goldens.string() + " -q --jobs 1 --profile --out " + out.string();
     ASSERT_EQ(run_command(cmd, text), 0) << text;
-    for (const char* stage : {"profile:", "precompute", "astc_encode", "spirv_compile_or_cache", "pipeline_create", "shading",
-                              "counting_twin", "metrics", "files", "results_and_report", "slowest tests"})
+    for (const char* stage :
+         {"profile:", "precompute", "precompute_store", "astc_encode", "spirv_compile_or_cache", "pipeline_create", "shading",
+          "counting_twin", "metrics", "files", "results_and_report", "slowest tests"})
         EXPECT_NE(text.find(stage), std::string::npos) << stage << " not in:\n" << text;
     const json results = json::parse(read_text(out / "results.json"));
     ASSERT_EQ(results["tests"].size(), 2u);
