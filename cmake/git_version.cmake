@@ -1,6 +1,8 @@
-# Writes OUT (a header) with the checkout's commit, run at every build by the iblcheck_git_version
-# target (harness/CMakeLists.txt); the header changes only when the commit or its dirty state does,
-# so only harness/cli/version.cpp recompiles then.  cmake -DSRC=<source dir> -DOUT=<header> -P this
+# Writes OUT (build/iblcheck_commit.txt, beside the binary) with the checkout's commit, run at every
+# build by the iblcheck_git_version target (harness/CMakeLists.txt). `iblcheck --version` reads it at
+# run time: compiled in, a new commit or a shader edit (which makes the tree dirty) recompiled
+# version.cpp and relinked the tool, so every bisect step relinked (issue 33).
+#   cmake -DSRC=<source dir> -DOUT=<file> -P this
 set(commit "unknown")
 find_package(Git QUIET)
 if(GIT_FOUND)
@@ -15,6 +17,6 @@ if(GIT_FOUND)
     endif()
   endif()
 endif()
-file(WRITE "${OUT}.tmp" "#define IBLCHECK_GIT_COMMIT \"${commit}\"\n")
+file(WRITE "${OUT}.tmp" "${commit}\n")
 file(COPY_FILE "${OUT}.tmp" "${OUT}" ONLY_IF_DIFFERENT)
 file(REMOVE "${OUT}.tmp")

@@ -7,6 +7,7 @@
 #include <thread>
 
 #include "golden_store.h"
+#include "harness/common/profile.h"
 #include "image_compare.h"
 #include "metrics/display_transform.h"
 #include "metrics/image_io.h"
@@ -24,6 +25,7 @@ Artefacts Artefacts::for_test(const fs::path& out_dir, const std::string& test) 
 std::string Artefacts::exr(const std::string& png) { return png.substr(0, png.rfind('.')) + ".exr"; }
 
 std::string Artefacts::png(const std::string& name, const cv::Mat& linear, bool with_exr) const {
+    ProfileStage stage("files");
     fs::create_directories(dir);
     write_png((dir / name).string(), display_transform(linear));
     if (with_exr) write_exr_half((dir / exr(name)).string(), linear);
@@ -31,6 +33,7 @@ std::string Artefacts::png(const std::string& name, const cv::Mat& linear, bool 
 }
 
 std::string Artefacts::shared_exr(const std::string& golden_rel, const cv::Mat& linear) const {
+    ProfileStage stage("files");
     const fs::path shared = dir.parent_path() / "_goldens";
     const std::string file = safe_file_name(golden_rel);
     if (!fs::exists(shared / file)) { // two workers (or processes) may both write it: same pixels, atomic rename
@@ -44,6 +47,7 @@ std::string Artefacts::shared_exr(const std::string& golden_rel, const cv::Mat& 
 }
 
 std::string Artefacts::heatmap(const std::string& name, const cv::Mat& errmap) const {
+    ProfileStage stage("files");
     fs::create_directories(dir);
     write_png((dir / name).string(), magma_heatmap(errmap));
     write_exr_half((dir / exr(name)).string(), errmap);
@@ -56,6 +60,7 @@ json Artefacts::images(const std::string& test, const std::string& golden, const
 }
 
 json Artefacts::layout(const SphereCoverage& coverage) const {
+    ProfileStage stage("files");
     SphereLayout l = sphere_layout(coverage);
     if (l.ids.empty()) return nullptr;
     fs::create_directories(dir);
@@ -66,6 +71,7 @@ json Artefacts::layout(const SphereCoverage& coverage) const {
 }
 
 void Artefacts::keep_float_render(const cv::Mat& image) const {
+    ProfileStage stage("files");
     fs::create_directories(dir);
     write_exr((dir / "test.exr").string(), image);
 }

@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "harness/common/profile.h"
 #include "renderers/renderer.h"
 
 using nlohmann::json;
@@ -60,6 +61,7 @@ std::vector<double> sphere_means(const cv::Mat& image, const SphereCoverage& cov
 } // namespace
 
 json furnace_figure(const TestCase& tc, Worker& w, const GoldenStore& store) {
+    ProfileStage stage("furnace"); // its render's own stages are counted as theirs
     if (tc.spec.method != "mobile" && tc.spec.method != "sampled") return nullptr;
     const TestSpec spec = furnace_spec(tc);
     const std::optional<Golden> truth = store.reference(spec);

@@ -7,6 +7,7 @@
 
 #include "bless.h"
 #include "harness/common/errors.h"
+#include "harness/common/profile.h"
 #include "image_compare.h"
 #include "provenance.h"
 
@@ -41,6 +42,7 @@ void note_worst_block(Comparison& c, const SphereCoverage& coverage, const FlipR
 // judge), else the same HDR-FLIP.
 json measure(const TestCase& tc, const cv::Mat& golden, const cv::Mat& image, int flip_threads, FlipResult& linear,
              FlipResult& shown) {
+    ProfileStage stage("metrics"); // FLIP, SSIM, PSNR (and the display space's)
     json m = compare_images(golden, image, flip_threads, &linear);
     if (!tc.display) {
         shown = linear;

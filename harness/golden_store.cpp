@@ -11,6 +11,7 @@
 
 #include "harness/common/errors.h"
 #include "harness/common/input_file.h"
+#include "harness/common/profile.h"
 #include "harness/common/program.h"
 #include "harness/common/shell_quote.h"
 #include "metrics/image_formats.h"
@@ -38,6 +39,7 @@ std::string run_capture(const std::string& cmd) {
 // its approved accuracy (the reference band would be silently dropped), and one with NaN/Inf
 // pixels judges nothing. Both are input errors naming the file.
 Golden load_golden(const fs::path& exr, const std::string& label) {
+    ProfileStage stage("golden_read");
     Golden g;
     g.image_path = exr;
     g.label = label;

@@ -6,15 +6,19 @@
 
 #include <atomic>
 #include <chrono>
+#include <map>
 #include <mutex>
 #include <thread>
 
 #include "harness/common/errors.h"
 #include "harness/common/output_files.h"
+#include "harness/common/profile.h"
 #include "provenance.h"
+#include "renderers/renderer.h"
 #include "reports/report_writer.h"
 #include "run_console.h"
 #include "run_files.h"
+#include "run_profile.h"
 #include "test_run.h"
 #include "verdict.h"
 #include "worker.h"
@@ -33,12 +37,13 @@ struct PoolOutcome {
     bool shader_error = false;
 };
 
-// The tests on `jobs` worker threads, each with its own renderer, taking the next test as it
-// finishes one; a line per test as it finishes unless quiet.
+// The tests on `jobs` worker threads, each with its own renderer, taking the next batch of tests as
+// it finishes one; a line per test as it finishes unless quiet. Results stay in suite order.
 PoolOutcome run_tests(const std::vector<TestCase>& tests, const RunOptions& o, const fs::path& out_dir, const GoldenStore& store,
                       int jobs, int timing_repeats) {
     const int flip_threads = jobs > 1 ? 1 : 0;
     std::vector<json> results(tests.size());
+    const std::vector<std::vector<size_t>> batches = precompute_batches(tests);
     std::atomic<size_t> next{0};
     std::atomic<int> done{0};
     std::atomic<bool> shader_error{false};
@@ -50,24 +55,25 @@ PoolOutcome run_tests(const std::vector<TestCase>& tests, const RunOptions& o, c
     auto work = [&] {
         try {
             Worker w(o.device);
-            for (size_t i; (i = next++) < tests.size();) {
-                bool se = false;
-                TestCase tc = tests[i];
-                if (o.stability) tc.stability.enabled = true;
-                results[i] = run_test(tc, w, store, out_dir, flip_threads, timing_repeats, se);
-                if (se) shader_error = true;
-                int n = ++done;
-                if (!o.quiet) {
-                    std::lock_guard lock(print_mutex);
-                    print_test_line(results[i], n, tests.size(), interactive, budget);
+            for (size_t b; (b = next++) < batches.size();)
+                for (size_t i : batches[b]) {
+                    bool se = false;
+                    TestCase tc = tests[i];
+                    if (o.stability) tc.stability.enabled = true;
+                    results[i] = run_test(tc, w, store, out_dir, flip_threads, timing_repeats, se);
+                    if (se) shader_error = true;
+                    int n = ++done;
+                    if (!o.quiet) {
+                        std::lock_guard lock(print_mutex);
+                        print_test_line(results[i], n, tests.size(), interactive, budget);
+                    }
                 }
-            }
             std::lock_guard lock(driver_mutex);
             if (json d = w.renderer.driver_json(); !d.empty()) driver = d;
         } catch (...) { // escaping the thread, it would abort the process (SIGABRT) with no results
             std::lock_guard lock(driver_mutex);
             if (!failure) failure = std::current_exception();
-            next = tests.size();
+            next = batches.size();
         }
     };
     std::vector<std::thread> pool;
@@ -110,6 +116,7 @@ void record_run(RunSummary& s, const std::string& suite, const RunOptions& o, Po
 // the run folder is swapped in as --out once all of it is written.
 void write_outputs(const json& R, const RunOptions& o, RunFolder& folder) {
     const fs::path& dir = folder.dir();
+    ProfileStage stage("results_and_report");
     if (!dir.empty()) write_json_atomically(dir / "results.json", R);
     if (!o.json.empty()) write_json_atomically(o.json, R);
     if (!o.junit.empty()) write_junit(R, o.junit);
@@ -141,6 +148,25 @@ void check_output_options(const RunOptions& o, const Suite& suite) {
 
 } // namespace
 
+std::vector<std::vector<size_t>> precompute_batches(const std::vector<TestCase>& tests) {
+    std::vector<std::vector<size_t>> batches;
+    std::map<std::string, size_t> batch_of;
+    for (size_t i = 0; i < tests.size(); ++i) {
+        std::string key;
+        try {
+            key = precompute_share_key(tests[i].spec);
+        } catch (const std::exception&) {
+            key = "unshared;" + std::to_string(i);
+        }
+        if (key.empty()) key = "unshared;" + std::to_string(i); // the CPU truth: nothing to share
+        auto [it, fresh] = batch_of.emplace(key, batches.size());
+        if (fresh) batches.emplace_back();
+        batches[it->second].push_back(i);
+    }
+    std::stable_sort(batches.begin(), batches.end(), [](const auto& a, const auto& b) { return a.size() > b.size(); });
+    return batches;
+}
+
 int RunSummary::exit_code() const {
     if (error) return kExitError;
     if (fail || missing) return kExitRegression;
@@ -167,6 +193,8 @@ RunSummary run_suite(const RunOptions& options) {
     jobs = std::max(1, std::min<int>(jobs, int(tests.size())));
     check_output_options(o, suite);
     RunFolder folder(o.out_dir, o.force);
+    profile::enable(o.profile);
+    profile::take(); // this thread's stages before the run (none counted twice)
 
     const auto t0 = std::chrono::steady_clock::now();
     PoolOutcome pool = run_tests(tests, o, folder.dir(), store, jobs, suite.timing_repeats);
@@ -180,6 +208,9 @@ RunSummary run_suite(const RunOptions& options) {
     }
     print_run_summary(s.results, s, tests.size(), o, tests[0].suite_arg,
                       tests[0].shader_arg); // -q drops the per-test lines, never this summary
+    if (o.profile)
+        print_profile(s.results, profile::take(), std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
+                      jobs);
     return s;
 }
 

@@ -37,6 +37,7 @@ struct RunOptions {
     bool stability = false; // measure determinism, noise floors and margins for every test
     // --findings: `iblcheck explain/explore --json` files for the report's findings (nightly_findings.h)
     std::vector<nlohmann::json> findings;
+    bool profile = false;   // print where the time went (run_profile.h); each test's results gain "profile"
 };
 
 struct RunSummary {
@@ -51,5 +52,11 @@ RunSummary run_suite(const RunOptions& options);
 // `o` with --history set to the suite's history file beside --out (Suite::history) when the run
 // names no --history and has an --out; otherwise `o` unchanged.
 RunOptions with_suite_history(RunOptions o, const Suite& suite);
+// `tests` (indices) in batches that share a GPU precompute (renderer.h: precompute_share_key),
+// largest first: a worker takes a whole batch, so its session computes that precompute once.
+// Handed out a test at a time, the two workers each computed most of them (the 71 ci tests: ~47
+// precomputes where 30 differ). A test whose options are bad gets a batch of its own (it fails
+// when it runs), and so does each CPU-truth test (nothing to share).
+std::vector<std::vector<size_t>> precompute_batches(const std::vector<TestCase>& tests);
 
 } // namespace iblcheck

@@ -10,6 +10,7 @@
 #include "furnace_figure.h"
 #include "golden_comparisons.h"
 #include "harness/common/errors.h"
+#include "harness/common/profile.h"
 #include "metrics/image_io.h"
 #include "provenance.h"
 #include "renderers/environments/environment.h"
@@ -202,12 +203,9 @@ Verdict decide(TestRun& t) {
     return v;
 }
 
-} // namespace
-
-json run_test(const TestCase& tc, Worker& w, const GoldenStore& store, const std::filesystem::path& out_dir, int flip_threads,
-              int timing_repeats, bool& shader_error) {
+json run_test_stages(const TestCase& tc, Worker& w, const GoldenStore& store, const std::filesystem::path& out_dir,
+                     int flip_threads, int timing_repeats, bool& shader_error) {
     TestRun t{tc, w, store, Artefacts::for_test(out_dir, tc.name), flip_threads, test_header(tc, store), {}, {}};
-    const auto t0 = std::chrono::steady_clock::now();
     cv::Mat image;
     try {
         RenderResult rr = w.renderer.render(tc.spec);
@@ -238,8 +236,23 @@ json run_test(const TestCase& tc, Worker& w, const GoldenStore& store, const std
             t.add(Verdict::error, e.what());
             decide(t);
         }
-    t.r["wall_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return std::move(t.r);
+}
+
+} // namespace
+
+json run_test(const TestCase& tc, Worker& w, const GoldenStore& store, const std::filesystem::path& out_dir, int flip_threads,
+              int timing_repeats, bool& shader_error) {
+    const auto t0 = std::chrono::steady_clock::now();
+    json r;
+    {
+        ProfileStage stage("test_other"); // what no stage inside names: verdicts, sidecars, the results object
+        r = run_test_stages(tc, w, store, out_dir, flip_threads, timing_repeats, shader_error);
+    }
+    // The whole test, its header included, so that its stages (all inside) add up to at most this.
+    r["wall_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (profile::enabled()) r["profile"] = profile::take(); // --profile: seconds per stage (run_profile.h)
+    return r;
 }
 
 } // namespace iblcheck

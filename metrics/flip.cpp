@@ -250,6 +250,19 @@ flip::ExposureRange flip_auto_exposure_range(const cv::Mat& ref_linear, flip::To
 }
 
 namespace {
+// Same size, type and bytes, and no NaN or Inf (whose error is not 0).
+bool identical_finite(const cv::Mat& a, const cv::Mat& b) {
+    if (a.size() != b.size() || a.type() != b.type() || a.depth() != CV_32F) return false;
+    for (int y = 0; y < a.rows; ++y) {
+        const float* p = a.ptr<float>(y);
+        const size_t n = size_t(a.cols) * a.channels();
+        if (std::memcmp(p, b.ptr<float>(y), n * sizeof(float)) != 0) return false;
+        for (size_t i = 0; i < n; ++i)
+            if (!std::isfinite(p[i])) return false;
+    }
+    return true;
+}
+
 // The tool's exposure rule over the pixels with positive luminance only.
 flip::ExposureRange lit_exposure_range(const cv::Mat& linear, flip::ToneMapper tm) {
     std::vector<float> lum;
@@ -344,6 +357,10 @@ FlipResult compute_flip_hdr(const cv::Mat& ref_linear, const cv::Mat& test_linea
     // Not cv::Mat::zeros: its MatExpr goes through a lazily built OpenCV singleton that TSan sees
     // racing between the runner's workers.
     r.errmap = cv::Mat(h, w, CV_32F, cv::Scalar(0));
+    if (opts.skip_identical && identical_finite(ref_linear, test_linear)) {
+        pool_flip_errmap(r);
+        return r;
+    }
     const Kernels& kern = opts.kernels ? *opts.kernels : default_kernels();
     FlipEngine engine(w, h, ppd, opts.threads, kern);
     const cv::Mat* imgs[2] = {&ref_linear, &test_linear};

@@ -5,6 +5,7 @@
 
 #include "harness/common/errors.h"
 #include "harness/common/hash.h"
+#include "harness/common/profile.h"
 #include "renderers/environments/environment.h"
 #include "renderers/mobile/gpu_session.h"
 #include "renderers/mobile/mobile_renderer.h"
@@ -67,17 +68,27 @@ void validate_spec(const TestSpec& spec) {
     build_scene(spec.scene, spec.options); // unknown scene or bad material option: UsageError
 }
 
+std::string precompute_share_key(const TestSpec& spec) {
+    if (spec.method == "mobile") return precompute_key(spec.env, mobile_precompute_settings(spec));
+    if (spec.method == "sampled") return precompute_key(spec.env, sampled_precompute_settings(spec));
+    return "";
+}
+
 Renderer::Renderer(vk::ContextOptions options) : options_(std::move(options)) {}
 Renderer::~Renderer() = default;
 
 GpuSession& Renderer::gpu() {
-    if (!gpu_) gpu_ = std::make_unique<GpuSession>(options_);
+    if (!gpu_) {
+        ProfileStage stage("vulkan_init"); // the instance, lavapipe's device, once per worker
+        gpu_ = std::make_unique<GpuSession>(options_);
+    }
     return *gpu_;
 }
 
 const Environment& Renderer::environment(const std::string& spec) {
     auto it = environments_.find(spec);
     if (it != environments_.end()) return *it->second;
+    ProfileStage stage("environment");
     auto env = std::make_unique<Environment>(load_environment(spec));
     return *environments_.emplace(spec, std::move(env)).first->second;
 }
@@ -90,6 +101,7 @@ nlohmann::json Renderer::driver_json() {
 }
 
 RenderResult Renderer::render(const TestSpec& spec) {
+    ProfileStage stage("render_other"); // validation, the source hashes, provenance: what no nested stage names
     validate_spec(spec);
     const Environment& env = environment(spec.env);
     auto t0 = std::chrono::steady_clock::now();

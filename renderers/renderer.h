@@ -24,6 +24,11 @@ std::vector<MethodInfo> method_catalog();
 // Throws UsageError for an unknown method, or an option key that `method` does not read.
 void validate_spec(const TestSpec& spec);
 
+// Which GPU precompute a render of `spec` needs (environment spec + settings; empty for the CPU
+// truth): the runner gives tests with the same key to the same worker, whose session computes it
+// once. Throws UsageError on a bad option, as render() would.
+std::string precompute_share_key(const TestSpec& spec);
+
 class Renderer {
   public:
     explicit Renderer(vk::ContextOptions options = {});

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -112,6 +113,30 @@ TEST(Flip, IdenticalImagesGiveZeroError) {
     EXPECT_EQ(r.mean, 0.0);
     const FlipResult h = compute_flip_hdr(a * 4.0, a * 4.0);
     EXPECT_EQ(h.max, 0.0);
+}
+
+// Issue 33: bit-identical inputs skip HDR-FLIP's exposures. The skipped evaluation gives the same
+// bits: on committed goldens (the ci suite's usual pass: a render equal to its baseline) and on
+// synthetic HDR with a 1e4 highlight, every statistic, the exposures and the error map match the
+// evaluated result exactly.
+TEST(Flip, IdenticalHdrInputsSkipTheExposuresWithTheSameResult) {
+    std::vector<cv::Mat> images;
+    for (const char* g :
+         {"goldens/baseline/mobile.roughness_sweep.sky_sun.default.exr", "goldens/reference/furnace__constant-1.exr"})
+        images.push_back(read_image(std::string(IBLCHECK_SOURCE_DIR) + "/" + g).pixels);
+    cv::Mat hdr = synthetic(97, 61, 3, 0.1f) * 8.0;
+    hdr.at<cv::Vec3f>(10, 20) = cv::Vec3f(1e4f, 9e3f, 8e3f);
+    images.push_back(hdr);
+    for (const cv::Mat& img : images) {
+        ASSERT_FALSE(img.empty());
+        FlipOptions evaluated;
+        evaluated.skip_identical = false;
+        const FlipResult a = compute_flip_hdr(img, img.clone()), b = compute_flip_hdr(img, img.clone(), evaluated);
+        EXPECT_EQ(flip_json(a).dump(), flip_json(b).dump());
+        ASSERT_EQ(a.errmap.size(), b.errmap.size());
+        EXPECT_EQ(std::memcmp(a.errmap.data, b.errmap.data, a.errmap.total() * sizeof(float)), 0);
+        EXPECT_EQ(b.max, 0.0); // what the skip assumes: identical inputs score 0 at every pixel
+    }
 }
 
 TEST(Flip, ErrorGrowsWithDistortion) {

@@ -65,6 +65,9 @@ void register_run(CLI::App& app, int& exit_code) {
     static bool list_only = false;
     r->add_flag("--list", list_only, "Print the selected tests' names and exit");
     r->add_flag("--stability", run.stability, "Also measure determinism, noise floors, sensitivity and margins");
+    r->add_flag("--profile", run.profile,
+                "Print where the time went: per stage (precompute, ASTC, SPIR-V, pipelines, "
+                "shading, the counting twin, metrics, files, report) and the slowest tests");
     static int repeat = 1;
     r->add_option("--repeat", repeat, "Run the suite N times; exit 1 if any verdict changes between runs")
         ->check(CLI::Range(1, 100));

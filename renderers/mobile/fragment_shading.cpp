@@ -3,6 +3,7 @@
 #include <cstring>
 
 #include "harness/common/errors.h"
+#include "harness/common/profile.h"
 #include "renderers/mobile/descriptor_types.h"
 #include "renderers/mobile/gpu_scene.h"
 #include "renderers/vulkan/spirv_cost.h"
@@ -88,6 +89,7 @@ FragmentShadingResult shade_fragment(GpuSession& gpu, const FragmentShadingPass&
     // The cost: the instrumented twin draws again, untimed, into a target of its own; its image
     // must be the timed draw's bit for bit, or the count would describe another computation.
     if (ctx.info().int64_atomics && ctx.info().graphics_stores) {
+        ProfileStage stage("counting_twin");
         vk::CompileOptions counting = pass.options;
         counting.count_instructions = true;
         const vk::GraphicsPipeline& counted = gpu.graphics_pipeline("shade_spheres.vert", "shade_spheres.frag", pass.defines,

@@ -1,5 +1,7 @@
 #include "gpu_session.h"
 
+#include "harness/common/profile.h"
+
 namespace iblcheck {
 
 namespace {
@@ -23,6 +25,7 @@ const vk::ComputePipeline& GpuSession::pipeline(const std::string& shader, const
     if (it != pipelines_.end()) return *it->second;
     vk::CompiledShader compiled = vk::compile_compute_shader(shader, defines, options);
     if (!options.count_instructions) shader_hashes_[shader] = compiled.source_hash;
+    ProfileStage stage("pipeline_create"); // lavapipe compiles the module with LLVM
     auto p = std::make_unique<vk::ComputePipeline>(*ctx_, compiled, bindings, push_bytes);
     return *pipelines_.emplace(key, std::move(p)).first->second;
 }
@@ -47,6 +50,7 @@ const vk::GraphicsPipeline& GpuSession::graphics_pipeline(const std::string& ver
     desc.bindings = bindings;
     desc.push_constant_bytes = push_bytes;
     desc.target = target;
+    ProfileStage stage("pipeline_create");
     auto p = std::make_unique<vk::GraphicsPipeline>(*ctx_, desc);
     return *graphics_pipelines_.emplace(key, std::move(p)).first->second;
 }

@@ -8,7 +8,9 @@
 #include "astc_storage.h"
 #include "env_layout.h"
 #include "harness/common/errors.h"
+#include "harness/common/profile.h"
 #include "mip_chain.h"
+#include "precompute_store.h"
 #include "renderers/mobile/descriptor_types.h"
 #include "renderers/mobile/push_constants.h"
 #include "renderers/option_table.h"
@@ -65,6 +67,7 @@ VkFormat storage_format(const std::string& storage, bool native_r11g11b10) {
 // pass samples. The encode and decode times are precompute passes (on the CPU).
 vk::Image astc_round_trip(vk::Context& ctx, const vk::Image& encoded, const PrecomputeSettings& s, float rgbm_range,
                           std::vector<PassTiming>& timings) {
+    ProfileStage stage("astc_encode");
     AstcFormat format;
     format.profile = s.storage == "astc_hdr" ? AstcProfile::hdr : AstcProfile::ldr_rgbm;
     format.block = astc_block_from_option(s.astc_block);
@@ -354,14 +357,17 @@ IblResources run_precompute(GpuSession& gpu, const Environment& env, const Preco
     return r;
 }
 
+std::string precompute_key(const std::string& env_id, const PrecomputeSettings& s) {
+    return "ibl;" + env_id + ";" + std::to_string(s.cube_size) + ";" + std::to_string(s.mips) + ";" +
+           std::to_string(s.prefilter_samples) + ";" + s.mip_mapping + ";" + s.storage + ";" + std::to_string(s.rgbm_range) +
+           ";" + s.astc_block + ";" + s.env_layout + ";" + std::to_string(s.prefiltered) + ";" + std::to_string(s.lut) + ";" +
+           std::to_string(s.lut_size) + ";" + std::to_string(s.lut_samples) + ";" + std::to_string(s.irradiance_cube) + ";" +
+           std::to_string(s.irradiance_size) + ";" + std::to_string(s.env_rotation_deg);
+}
+
 std::shared_ptr<IblResources> precompute_cached(GpuSession& gpu, const Environment& env, const PrecomputeSettings& s,
                                                 std::vector<PassTiming>& timings, bool& cached) {
-    std::string key = "ibl;" + env.content_hash + ";" + std::to_string(s.cube_size) + ";" + std::to_string(s.mips) + ";" +
-                      std::to_string(s.prefilter_samples) + ";" + s.mip_mapping + ";" + s.storage + ";" +
-                      std::to_string(s.rgbm_range) + ";" + s.astc_block + ";" + s.env_layout + ";" +
-                      std::to_string(s.prefiltered) + ";" + std::to_string(s.lut) + ";" + std::to_string(s.lut_size) + ";" +
-                      std::to_string(s.lut_samples) + ";" + std::to_string(s.irradiance_cube) + ";" +
-                      std::to_string(s.irradiance_size) + ";" + std::to_string(s.env_rotation_deg);
+    const std::string key = precompute_key(env.content_hash, s);
     // No shader hash in the key: the session's pipelines are cached by name and defines too, so a
     // session renders with the sources it first compiled either way.
     struct Entry {
@@ -375,7 +381,17 @@ std::shared_ptr<IblResources> precompute_cached(GpuSession& gpu, const Environme
     }
     cached = false;
     auto e = std::make_shared<Entry>();
-    e->ibl = std::make_shared<IblResources>(run_precompute(gpu, env, s, e->timings));
+    // A precompute an earlier run stored on disk (precompute_store.h: keyed by every input), else
+    // computed now and stored.
+    const std::string disk_key = precompute_store_key(gpu, env, s);
+    if (std::optional<IblResources> stored = load_precompute(gpu.ctx(), disk_key, e->timings)) {
+        cached = true;
+        e->ibl = std::make_shared<IblResources>(std::move(*stored));
+    } else {
+        ProfileStage stage("precompute");
+        e->ibl = std::make_shared<IblResources>(run_precompute(gpu, env, s, e->timings));
+        save_precompute(gpu.ctx(), disk_key, *e->ibl, e->timings);
+    }
     timings.insert(timings.end(), e->timings.begin(), e->timings.end());
     gpu.store(key, e);
     return e->ibl;

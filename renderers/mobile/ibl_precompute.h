@@ -60,6 +60,10 @@ IblResources run_precompute(GpuSession& gpu, const Environment& env, const Preco
 // run_precompute through the session's cache: the same environment and settings reuse the device
 // resources; `timings` receives the passes' timings as first measured (they are the cost of the
 // precompute, whether or not this render paid it). Sets `cached` when reused.
+// What identifies a precompute's result: the environment (`env_id`: its content hash, or for
+// grouping before anything is loaded its spec) and every setting.
+std::string precompute_key(const std::string& env_id, const PrecomputeSettings& s);
+
 std::shared_ptr<IblResources> precompute_cached(GpuSession& gpu, const Environment& env, const PrecomputeSettings& s,
                                                 std::vector<PassTiming>& timings, bool& cached);
 

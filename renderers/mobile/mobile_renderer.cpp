@@ -6,6 +6,7 @@
 #include "fragment_shading.h"
 #include "gpu_scene.h"
 #include "harness/common/errors.h"
+#include "harness/common/profile.h"
 #include "ibl_precompute.h"
 #include "mip_chain.h"
 #include "renderers/mobile/descriptor_types.h"
@@ -131,6 +132,7 @@ struct ShadingInputs {
 
 // shading=fragment into `result` (image, timings, texture fetches); returns its instruction count.
 std::optional<double> shade_with_fragments(GpuSession& gpu, const ShadingInputs& in, RenderResult& result) {
+    ProfileStage stage("shading");
     FragmentShadingResult f = shade_fragment(gpu, {in.defines, in.options, in.bindings, in.push, in.sphere_count});
     result.image = f.image;
     result.non_finite_coverage = f.non_finite_coverage;
@@ -141,6 +143,7 @@ std::optional<double> shade_with_fragments(GpuSession& gpu, const ShadingInputs&
 
 // shading=compute into `result` (image, timings, texture fetches); returns its instruction count.
 std::optional<double> shade_with_compute(GpuSession& gpu, const ShadingInputs& in, RenderResult& result) {
+    ProfileStage stage("shading");
     vk::Context& ctx = gpu.ctx();
     const int width = int(in.push.width), height = int(in.push.height);
     const std::vector<VkDescriptorType> types = {kStorageBuffer, kSampled, kStorageBuffer, kSampled, kSampled, kStorageBuffer};
@@ -184,6 +187,12 @@ nlohmann::json fragment_provenance(const ShadingInputs& in, double texture_fetch
 }
 
 } // namespace
+
+PrecomputeSettings mobile_precompute_settings(const TestSpec& spec) {
+    PrecomputeSettings ps = read_mobile_options(spec.options).ps;
+    if (!spec.shader.empty()) ps.lut = true; // as render_mobile: the contract always binds the DFG LUT
+    return ps;
+}
 
 RenderResult render_mobile(GpuSession& gpu, const Environment& env, const TestSpec& spec) {
     const OptionMap& o = spec.options;

@@ -3,11 +3,13 @@
 #include <cstring>
 
 #include "harness/common/errors.h"
+#include "harness/common/profile.h"
 #include "renderers/vulkan/spirv_cost.h"
 
 namespace iblcheck {
 
 std::optional<double> shading_instructions_per_pixel(GpuSession& gpu, const ShadingPass& pass, const vk::Buffer& out) {
+    ProfileStage stage("counting_twin");
     vk::Context& ctx = gpu.ctx();
     if (!ctx.info().int64_atomics) return std::nullopt;
     vk::CompileOptions options = pass.options;

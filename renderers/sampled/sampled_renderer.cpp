@@ -3,6 +3,7 @@
 #include "sampled_renderer.h"
 
 #include "harness/common/errors.h"
+#include "harness/common/profile.h"
 #include "renderers/mobile/gpu_scene.h"
 #include "renderers/mobile/ibl_precompute.h"
 #include "renderers/mobile/push_constants.h"
@@ -11,15 +12,20 @@
 
 namespace iblcheck {
 
+PrecomputeSettings sampled_precompute_settings(const TestSpec& spec) {
+    PrecomputeSettings ps;
+    ps.cube_size = uint32_t(spec.options.get_int("cube_size", 256));
+    ps.prefiltered = false;
+    ps.env_rotation_deg = float(spec.options.get_double("env_rotation", 0.0));
+    return ps;
+}
+
 RenderResult render_sampled(GpuSession& gpu, const Environment& env, const TestSpec& spec) {
     const OptionMap& o = spec.options;
     int width = 0, height = 0;
     Scene scene = scene_for(spec, width, height);
 
-    PrecomputeSettings ps;
-    ps.cube_size = uint32_t(o.get_int("cube_size", 256));
-    ps.prefiltered = false;
-    ps.env_rotation_deg = float(o.get_double("env_rotation", 0.0));
+    const PrecomputeSettings ps = sampled_precompute_settings(spec);
     int samples = o.get_int("samples", 64);
     if (samples < 1 || samples > 65536) throw UsageError("option 'samples' must be in 1..65536");
 
@@ -31,6 +37,7 @@ RenderResult render_sampled(GpuSession& gpu, const Environment& env, const TestS
                                                  VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
                                                  VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
     const vk::Defines defines = glsl_defines(shader_selections(o, "sampled")); // mip_clamp
+    ProfileStage stage("shading");
     const auto& shade = gpu.pipeline("shade_sampled.comp", defines, types, sizeof(SampledPush));
     vk::Context& ctx = gpu.ctx();
     vk::Buffer scene_buf = upload_scene(ctx, scene);

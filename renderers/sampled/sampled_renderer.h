@@ -3,8 +3,11 @@
 #pragma once
 #include "renderers/environments/environment.h"
 #include "renderers/mobile/gpu_session.h"
+#include "renderers/mobile/ibl_precompute.h"
 #include "renderers/render_api.h"
 
 namespace iblcheck {
 RenderResult render_sampled(GpuSession& gpu, const Environment& env, const TestSpec& spec);
-}
+// The source pyramid and SH9 a sampled render of `spec` asks for (no prefiltered chain).
+PrecomputeSettings sampled_precompute_settings(const TestSpec& spec);
+} // namespace iblcheck

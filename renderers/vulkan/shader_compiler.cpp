@@ -17,6 +17,7 @@
 #include "fp16_pass_hash.h" // generated: IBLCHECK_FP16_PASS_HASH
 #include "harness/common/errors.h"
 #include "harness/common/hash.h"
+#include "harness/common/profile.h"
 #include "spirv_cost.h"
 
 namespace fs = std::filesystem;
@@ -164,6 +165,13 @@ void check_ibl_shade_file(const fs::path& file) {
     static const std::regex fn(R"re(\bvec3\s+ibl_shade\s*\()re");
     if (!std::regex_search(read_text(file), fn))
         throw InputError(file.string() + ": no function `vec3 ibl_shade(IblSurface s, IblInputs ibl)` (docs/SHADER_CONTRACT.md)");
+}
+
+std::string file_tree_hash(const fs::path& file) {
+    Fnv1a64 h;
+    std::set<fs::path> seen;
+    hash_sources(fs::weakly_canonical(file), h, seen, {});
+    return h.hex();
 }
 
 std::string ibl_shade_hash(const fs::path& file) {
@@ -329,6 +337,7 @@ void apply_passes(std::vector<uint32_t>& spirv, const CompileOptions& options, c
 }
 
 CompiledShader compile_stage_file(const fs::path& path_in, Stage stage, const Defines& defines, const CompileOptions& options) {
+    ProfileStage profile_stage("spirv_compile_or_cache");
     const fs::path path = fs::weakly_canonical(path_in);
     if (!options.ibl_shade.empty()) check_ibl_shade_file(options.ibl_shade); // before its text is hashed
     CompiledShader out;

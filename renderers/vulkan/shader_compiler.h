@@ -68,6 +68,8 @@ inline constexpr const char* kIblShadeInclude = "ibl_shade_user.glsl";
 void check_ibl_shade_file(const std::filesystem::path& file);
 // A hash of a team's shading file and, recursively, every file it includes: its provenance.
 std::string ibl_shade_hash(const std::filesystem::path& file);
+// The same over a harness shader (a pass under shader_dir()): its text and every file it includes.
+std::string file_tree_hash(const std::filesystem::path& file);
 
 // Where cached SPIR-V goes: $IBLCHECK_CACHE_DIR/spirv or <source root>/.cache/spirv.
 std::filesystem::path spirv_cache_dir();

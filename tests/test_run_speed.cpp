@@ -1,0 +1,292 @@
+// Issue 33: the ci suite's time. `run --profile` says where it goes (per stage, per test), and the
+// work shared between tests stays correct. No test here measures a time: each checks what the
+// profile names and that its figures add up, or that a cache misses when an input changes
+// (scripts/bench_speed.sh prints the timings).
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <string>
+
+#include "harness/common/profile.h"
+#include "harness/runner.h"
+#include "harness/suite.h"
+#include "renderers/environments/environment.h"
+#include "renderers/mobile/precompute_store.h"
+#include "renderers/renderer.h"
+#include "renderers/vulkan/shader_compiler.h"
+#include "tests/furnace_store.h"
+#include "tests/test_support.h"
+
+namespace fs = std::filesystem;
+using namespace iblcheck;
+using namespace iblcheck::testutil;
+using nlohmann::json;
+
+namespace {
+
+// Work the compiler cannot drop, so a stage has a duration above zero.
+double spin(int n) {
+    volatile double x = 0;
+    for (int i = 0; i < n; ++i) x = x + 1e-9 * i;
+    return x;
+}
+
+const char* kSuite = R"({
+  "suite": "mini",
+  "defaults": {"env": "constant:1",
+               "baseline_tolerances": {"flip.mean": {"max": 0.001}, "ssim.mean": {"min": 0.999}},
+               "reference_band": {"flip.mean": {"below": 0.2, "above": 0.1, "abs": 0.0}}},
+  "tests": [{"scene": "furnace", "method": "mobile", "variants": [{}, {"storage": "astc_hdr"}]}]
+})";
+
+} // namespace
+
+// Nested stages: the outer stage's clock stops while the inner one runs, so neither counts the
+// other's time; off, nothing is recorded.
+TEST(Profile, StagesNestExclusivelyAndRecordNothingWhenOff) {
+    profile::enable(false);
+    profile::take();
+    {
+        ProfileStage outer("outer");
+        spin(100000);
+    }
+    EXPECT_TRUE(profile::take().empty());
+
+    profile::enable(true);
+    profile::take();
+    const auto t0 = std::chrono::steady_clock::now();
+    {
+        ProfileStage outer("outer");
+        spin(200000);
+        {
+            ProfileStage inner("inner");
+            spin(200000);
+        }
+        spin(200000);
+    }
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const auto stages = profile::take();
+    profile::enable(false);
+    ASSERT_EQ(stages.size(), 2u);
+    EXPECT_GT(stages.at("outer"), 0.0);
+    EXPECT_GT(stages.at("inner"), 0.0);
+    // Exclusive: together they are the block's wall time, never more (nested time counted twice was).
+    EXPECT_LE(stages.at("outer") + stages.at("inner"), wall);
+    EXPECT_TRUE(profile::take().empty()); // take() cleared them
+}
+
+// `run --profile` prints the stages of the issue and each test's results carry them; the stages
+// of a test add up to (at most) its wall time. Without it the results have no "profile".
+TEST(Profile, RunPrintsStagesAndEachTestRecordsThem) {
+    FurnaceStore store("profile_run", kSuite);
+    ASSERT_EQ(store.bless_all(), kExitPass);
+    const fs::path out = store.dir / "out";
+    std::string text;
+    // An empty precompute store of its own, so the precompute and the ASTC encode run (and are stored).
+    const std::string cmd = "IBLCHECK_PRECOMPUTE_CACHE=" + (store.dir / "precompute").string() + " " +
+                            std::string(IBLCHECK_BINARY_DIR) + "/iblcheck run --suite " + store.suite.string() + " --goldens " +
+                            store.goldens.string() + " -q --jobs 1 --profile --out " + out.string();
+    ASSERT_EQ(run_command(cmd, text), 0) << text;
+    for (const char* stage :
+         {"profile:", "precompute", "precompute_store", "astc_encode", "spirv_compile_or_cache", "pipeline_create", "shading",
+          "counting_twin", "metrics", "files", "results_and_report", "slowest tests"})
+        EXPECT_NE(text.find(stage), std::string::npos) << stage << " not in:\n" << text;
+    const json results = json::parse(read_text(out / "results.json"));
+    ASSERT_EQ(results["tests"].size(), 2u);
+    for (const json& t : results["tests"]) {
+        ASSERT_TRUE(t.contains("profile")) << t["name"];
+        double sum = 0;
+        for (const auto& [stage, s] : t["profile"].items()) sum += s.get<double>();
+        EXPECT_GT(t["profile"].value("shading", 0.0), 0.0) << t["name"];
+        EXPECT_GT(t["profile"].value("metrics", 0.0), 0.0) << t["name"];
+        EXPECT_LE(sum, t["wall_s"].get<double>() + 1e-3) << t["name"]; // exclusive stages: no time counted twice
+    }
+    EXPECT_GT(results["tests"][1]["profile"].value("astc_encode", 0.0), 0.0); // the ASTC variant's encode is its own stage
+
+    RunOptions o;
+    o.suite = store.suite.string();
+    o.goldens = store.goldens;
+    o.quiet = true;
+    const RunSummary plain = run_suite(o);
+    EXPECT_FALSE(plain.results["tests"][0].contains("profile"));
+}
+
+// The ci suite's tests in batches that share a precompute: every test once, one key per batch and
+// no key in two batches; the options that only change the shading (dominant_dir, normalization,
+// shading=fragment, another scene) share the default's batch, a storage or mip curve does not.
+TEST(SharedPrecompute, CiTestsAreBatchedByTheirPrecompute) {
+    const std::vector<TestCase> tests = load_suite("ci").tests;
+    const auto batches = precompute_batches(tests);
+    std::set<size_t> seen;
+    std::set<std::string> keys;
+    std::map<std::string, size_t> batch_of;
+    for (size_t b = 0; b < batches.size(); ++b) {
+        ASSERT_FALSE(batches[b].empty());
+        const std::string key = precompute_share_key(tests[batches[b][0]].spec);
+        EXPECT_TRUE(keys.insert(key).second) << "two batches share " << key;
+        for (size_t i : batches[b]) {
+            EXPECT_TRUE(seen.insert(i).second) << tests[i].name << " in two batches";
+            EXPECT_EQ(precompute_share_key(tests[i].spec), key) << tests[i].name;
+            batch_of[tests[i].name] = b;
+        }
+        if (b > 0) {
+            EXPECT_LE(batches[b].size(), batches[b - 1].size()); // largest first
+        }
+    }
+    EXPECT_EQ(seen.size(), tests.size());
+    const size_t studio = batch_of.at("mobile.roughness_sweep.studio.default");
+    for (const char* same :
+         {"mobile.roughness_sweep.studio.dominant_dir=lagarde", "mobile.roughness_sweep.studio.normalization=ue4",
+          "mobile.roughness_sweep.studio.shading=fragment", "mobile.sphere.studio.default"})
+        EXPECT_EQ(batch_of.at(same), studio) << same;
+    for (const char* other : {"mobile.roughness_sweep.studio.storage=rgbm8", "mobile.roughness_sweep.studio.mip_mapping=origin",
+                              "mobile.roughness_sweep.sky_sun.default", "sampled.roughness_sweep.studio.samples=64"})
+        EXPECT_NE(batch_of.at(other), studio) << other;
+    EXPECT_LT(batches.size(), tests.size()); // the sharing is real (71 tests, 35 precomputes on 2026-11-26)
+}
+
+// Two workers on tests that interleave two precomputes, the first two tests sharing one: each is
+// computed once (a render that reused it says so in its provenance). Handed out a test at a time,
+// the two workers took the first two tests and both computed the first precompute.
+TEST(SharedPrecompute, TwoWorkersComputeEachPrecomputeOnce) {
+    const char* suite = R"({
+  "suite": "mini",
+  "defaults": {"env": "constant:1",
+               "baseline_tolerances": {"flip.mean": {"max": 0.001}, "ssim.mean": {"min": 0.999}},
+               "reference_band": {"flip.mean": {"below": 0.2, "above": 0.1, "abs": 0.0}}},
+  "tests": [{"scene": "furnace", "method": "mobile", "variants": [{}, {"dominant_dir": "lagarde"}, {"storage": "rgbm8"},
+            {"storage": "rgbm8", "dominant_dir": "lagarde"}, {"normalization": "ue4"}, {"storage": "rgbm8", "normalization": "ue4"}]}]
+})";
+    FurnaceStore store("shared_precompute", suite);
+    ASSERT_EQ(store.bless_all(), kExitPass);
+    RunOptions o;
+    o.suite = store.suite.string();
+    o.goldens = store.goldens;
+    o.quiet = true;
+    o.jobs = 2;
+    setenv("IBLCHECK_PRECOMPUTE_CACHE", "0", 1); // the count is of this run's precomputes, none from disk
+    const RunSummary s = run_suite(o);
+    unsetenv("IBLCHECK_PRECOMPUTE_CACHE");
+    ASSERT_EQ(s.results["tests"].size(), 6u);
+    int computed = 0;
+    for (const json& t : s.results["tests"]) {
+        EXPECT_EQ(t["verdict"], "pass") << t["name"] << ": " << t["message"];
+        computed += t["provenance"]["precompute_cached"].get<bool>() ? 0 : 1;
+    }
+    EXPECT_EQ(computed, 2);
+}
+
+namespace {
+
+// A render of `spec` with a fresh renderer (no session cache) and the precompute store at `store`
+// ("0": off).
+RenderResult fresh_render(const TestSpec& spec, const std::string& store) {
+    setenv("IBLCHECK_PRECOMPUTE_CACHE", store.c_str(), 1);
+    Renderer r;
+    RenderResult out = r.render(spec);
+    unsetenv("IBLCHECK_PRECOMPUTE_CACHE");
+    return out;
+}
+
+bool same_pixels(const cv::Mat& a, const cv::Mat& b) {
+    return a.size() == b.size() && a.type() == b.type() && std::memcmp(a.data, b.data, a.total() * a.elemSize()) == 0;
+}
+
+TestSpec furnace_spec(const std::map<std::string, std::string>& options) {
+    TestSpec s;
+    s.scene = "furnace";
+    s.method = "mobile";
+    s.env = "studio";
+    s.options.set("cube_size", "32");
+    for (const auto& [k, v] : options) s.options.set(k, v);
+    return s;
+}
+
+} // namespace
+
+// A precompute stored on disk renders bit-identically to one computed now, for every storage format
+// the store holds (RGBA16F, RGBM8, R11G11B10, ASTC's decoded texels), a 2D layout, the LUT and the
+// irradiance cube; a damaged entry is computed again, never read.
+TEST(PrecomputeStore, StoredPrecomputeRendersBitIdenticallyAndADamagedEntryIsRecomputed) {
+    const fs::path dir = temp_dir("precompute_store");
+    for (const auto& options :
+         std::vector<std::map<std::string, std::string>>{{},
+                                                         {{"storage", "rgbm8"}},
+                                                         {{"storage", "r11g11b10"}},
+                                                         {{"storage", "astc_hdr"}},
+                                                         {{"env_layout", "octahedral"}},
+                                                         {{"env_brdf", "lut"}, {"diffuse", "irradiance_cube"}}}) {
+        const TestSpec spec = furnace_spec(options);
+        const std::string what = spec.options.canonical();
+        const RenderResult computed = fresh_render(spec, "0");
+        const RenderResult stored = fresh_render(spec, dir.string()); // computes it and stores it
+        const RenderResult loaded = fresh_render(spec, dir.string()); // reads it
+        EXPECT_FALSE(stored.provenance["precompute_cached"].get<bool>()) << what;
+        EXPECT_TRUE(loaded.provenance["precompute_cached"].get<bool>()) << what;
+        EXPECT_TRUE(same_pixels(computed.image, stored.image)) << what;
+        EXPECT_TRUE(same_pixels(computed.image, loaded.image)) << what;
+        EXPECT_EQ(computed.provenance["rgbm"], loaded.provenance["rgbm"]) << what;
+        EXPECT_EQ(computed.provenance["texture"], loaded.provenance["texture"]) << what;
+    }
+    // Every entry cut in half: each render computes its precompute again, and renders the same.
+    for (const auto& e : fs::directory_iterator(dir)) fs::resize_file(e.path(), fs::file_size(e.path()) / 2);
+    const TestSpec spec = furnace_spec({{"storage", "rgbm8"}});
+    const RenderResult again = fresh_render(spec, dir.string());
+    EXPECT_FALSE(again.provenance["precompute_cached"].get<bool>());
+    EXPECT_TRUE(same_pixels(again.image, fresh_render(spec, "0").image));
+    fs::remove_all(dir);
+}
+
+// The entry's key changes with every input: the environment's pixels, a setting, a pass shader's
+// include (not only the pass's own file), llvmpipe's CPU class; the same inputs give the same key.
+TEST(PrecomputeStore, AChangedInputMisses) {
+    GpuSession gpu;
+    const Environment studio = load_environment("studio"), sky = load_environment("sky_sun");
+    PrecomputeSettings s;
+    const std::string key = precompute_store_key(gpu, studio, s);
+    EXPECT_EQ(precompute_store_key(gpu, studio, s), key);
+    EXPECT_NE(precompute_store_key(gpu, sky, s), key);
+    PrecomputeSettings other = s;
+    other.storage = "rgbm8";
+    EXPECT_NE(precompute_store_key(gpu, studio, other), key);
+    other = s;
+    other.prefilter_samples = 128;
+    EXPECT_NE(precompute_store_key(gpu, studio, other), key);
+
+    // A copy of the shaders whose brdf.glsl (included by prefilter_ggx.comp) gained a comment.
+    const fs::path shaders = temp_dir("precompute_store_shaders");
+    fs::copy(vk::shader_dir(), shaders, fs::copy_options::recursive);
+    std::ofstream(shaders / "brdf.glsl", std::ios::app) << "\n// edited\n";
+    setenv("IBLCHECK_SHADER_DIR", shaders.c_str(), 1);
+    const std::string edited = precompute_store_key(gpu, studio, s);
+    unsetenv("IBLCHECK_SHADER_DIR");
+    fs::remove_all(shaders);
+    EXPECT_NE(edited, key);
+
+    // Another CPU class (llvmpipe generates other code for it).
+    setenv("GALLIUM_OVERRIDE_CPU_CAPS", "sse4.1", 1);
+    const std::string other_cpu = precompute_store_key(gpu, studio, s);
+    unsetenv("GALLIUM_OVERRIDE_CPU_CAPS");
+    EXPECT_NE(other_cpu, key);
+}
+
+// `--version` reads the commit from iblcheck_commit.txt beside the binary (written at every build),
+// so a bisect step whose commit (or a shader edit's dirty state) changed relinks nothing; compiled
+// in, it recompiled version.cpp and relinked the tool at every step. Without the file: "unknown".
+TEST(BisectStep, VersionReadsTheCommitBesideTheBinary) {
+    const fs::path dir = temp_dir("version_file");
+    for (const char* f : {"iblcheck", "libiblcheck_oiio.so"}) fs::copy(fs::path(IBLCHECK_BINARY_DIR) / f, dir / f);
+    std::string out;
+    ASSERT_EQ(run_command((dir / "iblcheck").string() + " --version", out), 0) << out;
+    EXPECT_NE(out.find("(commit unknown,"), std::string::npos) << out;
+    write_file(dir / "iblcheck_commit.txt", "0123456789ab-dirty\n");
+    ASSERT_EQ(run_command((dir / "iblcheck").string() + " --version", out), 0) << out;
+    EXPECT_NE(out.find("(commit 0123456789ab-dirty,"), std::string::npos) << out;
+    fs::remove_all(dir);
+}
