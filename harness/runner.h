@@ -37,7 +37,7 @@ struct RunOptions {
     bool stability = false; // measure determinism, noise floors and margins for every test
     // --findings: `iblcheck explain/explore --json` files for the report's findings (nightly_findings.h)
     std::vector<nlohmann::json> findings;
-    bool profile = false;   // print where the time went (run_profile.h); each test's results gain "profile"
+    bool profile = false; // print where the time went (run_profile.h); each test's results gain "profile"
 };
 
 struct RunSummary {
