@@ -20,6 +20,7 @@
 #include "harness/run_console.h"
 #include "harness/runner.h"
 #include "harness/suite.h"
+#include "renderers/environments/environment.h"
 #include "tests/test_support.h"
 
 namespace fs = std::filesystem;
@@ -412,6 +413,20 @@ TEST(Suites, TemporalAndStabilitySuitesPass) {
     EXPECT_EQ(run_command(iblcheck_bin() + " run --suite temporal", out), 0) << out;
     EXPECT_EQ(run_command(iblcheck_bin() + " run --suite stability", out), 0) << out;
     EXPECT_NE(out.find("0 fail"), std::string::npos) << out;
+}
+
+TEST(Suites, ExploreWinnersHoldTheirBaselinesAndAccuracy) {
+    // Issue 26: the configurations `iblcheck explore` found (harness/suites/explore_winners.json, one per
+    // environment) are held by the default test run: their baselines gate a shader change and their
+    // reference bands hold the accuracy against the truth that made them winners.
+    try {
+        load_environment("blender:sunrise"); // the third winner's environment (scripts/setup.sh installs it)
+    } catch (const InputError& err) {
+        GTEST_SKIP() << "blender:sunrise not present (" << err.what() << ")";
+    }
+    std::string out;
+    EXPECT_EQ(run_command(iblcheck_bin() + " run --suite explore_winners", out), 0) << out;
+    EXPECT_NE(out.find("3 tests: 3 pass"), std::string::npos) << out;
 }
 
 TEST(Temporal, BrokenSpecularAntiAliasingFailsTheGate) {
