@@ -4,6 +4,7 @@
 
 #include "metrics/display_transform.h"
 #include "metrics/flip_json.h"
+#include "metrics/identical.h"
 #include "metrics/psnr.h"
 #include "metrics/ssim.h"
 
@@ -21,7 +22,8 @@ json psnr_json(const PsnrResult& p) {
 
 json compare_in_display(const cv::Mat& golden, const cv::Mat& test, const DisplaySpace& display, int flip_threads,
                         FlipResult* flip_out) {
-    const cv::Mat g = to_display(golden, display), t = to_display(test, display);
+    // A render bit-identical to its golden shows the same display image: transformed once.
+    const cv::Mat g = to_display(golden, display), t = identical_finite(golden, test) ? g : to_display(test, display);
     FlipOptions fo;
     fo.threads = flip_threads;
     FlipResult f = compute_flip_ldr(g, t, fo);
@@ -38,10 +40,13 @@ json compare_images(const cv::Mat& golden, const cv::Mat& test, int flip_threads
     FlipOptions fo;
     fo.threads = flip_threads;
     FlipResult f = compute_flip_hdr(golden, test, fo);
-    PsnrResult p = compute_psnr(display_transform(golden), display_transform(test));
+    // SSIM and PSNR on the display transform, computed once for both (compute_ssim_hdr's); a render
+    // bit-identical to its golden transforms once, and both metrics skip (metrics/identical.h).
+    const cv::Mat dg = display_transform(golden), dt = identical_finite(golden, test) ? dg : display_transform(test);
+    PsnrResult p = compute_psnr(dg, dt);
     json j;
     j["flip"] = flip_json(f);
-    j["ssim"] = ssim_applicable(golden) ? json{{"mean", compute_ssim_hdr(golden, test).mean}} : ssim_not_applicable();
+    j["ssim"] = ssim_applicable(golden) ? json{{"mean", compute_ssim(dg, dt).mean}} : ssim_not_applicable();
     j["psnr"] = psnr_json(p);
     if (display) j.update(compare_in_display(golden, test, *display, flip_threads));
     if (flip_out) *flip_out = std::move(f);

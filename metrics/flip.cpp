@@ -22,6 +22,8 @@
 
 #include <fmt/core.h>
 
+#include "metrics/identical.h"
+
 #include "harness/common/errors.h"
 #include "metrics/flip/color_spaces.h"
 #include "metrics/flip/csf_filters.h"
@@ -250,19 +252,6 @@ flip::ExposureRange flip_auto_exposure_range(const cv::Mat& ref_linear, flip::To
 }
 
 namespace {
-// Same size, type and bytes, and no NaN or Inf (whose error is not 0).
-bool identical_finite(const cv::Mat& a, const cv::Mat& b) {
-    if (a.size() != b.size() || a.type() != b.type() || a.depth() != CV_32F) return false;
-    for (int y = 0; y < a.rows; ++y) {
-        const float* p = a.ptr<float>(y);
-        const size_t n = size_t(a.cols) * a.channels();
-        if (std::memcmp(p, b.ptr<float>(y), n * sizeof(float)) != 0) return false;
-        for (size_t i = 0; i < n; ++i)
-            if (!std::isfinite(p[i])) return false;
-    }
-    return true;
-}
-
 // The tool's exposure rule over the pixels with positive luminance only.
 flip::ExposureRange lit_exposure_range(const cv::Mat& linear, flip::ToneMapper tm) {
     std::vector<float> lum;

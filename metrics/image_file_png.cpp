@@ -76,6 +76,9 @@ bool png_write(png_structp png, png_infop info, FILE* f, int w, int h, int chann
     png_init_io(png, f);
     png_set_IHDR(png, info, png_uint_32(w), png_uint_32(h), 8, channels == 1 ? PNG_COLOR_TYPE_GRAY : PNG_COLOR_TYPE_RGB,
                  PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+    // zlib level 1 (fastest): a ci run's report writes its PNGs (11 MB) in ~1.4 s less worker time
+    // than at the default level 6, for 10 % more bytes (issue 33).
+    png_set_compression_level(png, 1);
     png_write_info(png, info);
     png_write_image(png, rows);
     png_write_end(png, nullptr);

@@ -4,6 +4,7 @@
 #include <limits>
 
 #include "harness/common/errors.h"
+#include "metrics/identical.h"
 
 namespace iblcheck {
 
@@ -14,8 +15,9 @@ void check(const cv::Mat& a, const cv::Mat& b, const char* what) {
 }
 } // namespace
 
-PsnrResult compute_psnr(const cv::Mat& ref, const cv::Mat& test, double data_range) {
+PsnrResult compute_psnr(const cv::Mat& ref, const cv::Mat& test, double data_range, bool skip_identical) {
     check(ref, test, "PSNR");
+    if (skip_identical && identical_finite(ref, test)) return {std::numeric_limits<double>::infinity(), 0.0, 0.0, 0.0};
     double sse = 0.0, max_abs = 0.0;
     const int n = ref.cols * ref.channels();
     for (int y = 0; y < ref.rows; ++y) {

@@ -13,7 +13,9 @@ struct PsnrResult {
 
 // PSNR with data range 1 (display values in [0,1]), as scikit-image's
 // peak_signal_noise_ratio(data_range=1).
-PsnrResult compute_psnr(const cv::Mat& ref, const cv::Mat& test, double data_range = 1.0);
+// skip_identical: bit-identical finite inputs (metrics/identical.h) give what the loop computes for
+// them without it: every difference +0.0, so MSE, RMSE and max_abs 0 and db +inf.
+PsnrResult compute_psnr(const cv::Mat& ref, const cv::Mat& test, double data_range = 1.0, bool skip_identical = true);
 
 // Relative MSE for HDR radiance: mean over channel values of (t - r)^2 / (r^2 + eps), eps = 1e-2.
 // Dividing by r^2 makes an error count relative to the local brightness (a 0.1 error on a

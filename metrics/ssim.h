@@ -20,7 +20,11 @@ struct SsimResult {
 };
 
 // Inputs: CV_32FC3 display values in [0,1] (sRGB-encoded for LDR). Same size, >= 11x11.
-SsimResult compute_ssim(const cv::Mat& a, const cv::Mat& b);
+// skip_identical: bit-identical finite inputs (metrics/identical.h) give 1 in every channel without
+// the filtering, exactly what it computes: with x = y each window's numerator and denominator are
+// the same products of the same doubles (2·mx·my = mx² + my², vxy = vx = vy), so each term is 1.0,
+// their sum the count, and the means 1.0.
+SsimResult compute_ssim(const cv::Mat& a, const cv::Mat& b, bool skip_identical = true);
 
 // For HDR inputs: both go through display_transform() (metrics/display_transform.h) first.
 SsimResult compute_ssim_hdr(const cv::Mat& ref_linear, const cv::Mat& test_linear);

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Issue 33's figures, measured in one run on this machine for this checkout and for a build of a
 # base commit side by side (same moment, same load), with their ratios (this / base):
-#   - the ci suite: this checkout with its precompute store empty (cold) and filled (warm, a shader
-#     author's next run), the base (its SPIR-V cache warm after the first run);
+#   - the ci suite: this checkout with its precompute and cost stores empty (cold) and filled (warm,
+#     a shader author's next run), the base (its SPIR-V cache warm after the first run);
 #   - a bisect step (`iblcheck bisect` on the studio roughness sweep; the build excluded), and
 #     whether an edit of one shader relinks the tool (it should not need to);
 #   - with --nightly: the nightly suite (wall, CPU, peak memory); with --full-build: a fresh clone's
@@ -51,6 +51,8 @@ ratio() { printf '  %-28s %.2f wall, %.2f CPU\n' "$1/$2" "$(echo "${wall[$1]} / 
 echo "[bench] $(nproc) cores; this: $(git -C "$root" rev-parse --short HEAD), base: $base_rev ($base_dir)"
 echo "ci suite (iblcheck run --suite ci -q):"
 store="$tmp/precompute"
+# The counting twin's store (issue 33) starts empty with the precompute store: cold is cold.
+export IBLCHECK_COST_CACHE="$tmp/cost"
 measure base_ci_first "$base_dir" build/iblcheck run --suite ci -q
 IBLCHECK_PRECOMPUTE_CACHE="$store" measure this_ci_cold "$root" build/iblcheck run --suite ci -q
 measure base_ci "$base_dir" build/iblcheck run --suite ci -q

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -16,6 +17,7 @@
 #include "metrics/psnr.h"
 #include "metrics/ssim.h"
 #include "metrics/temporal.h"
+#include "tests/synthetic_image.h"
 #include "tests/test_support.h"
 
 namespace fs = std::filesystem;
@@ -285,3 +287,33 @@ TEST(Validation, FiniteNegativeAndSize) {
 }
 
 } // namespace
+
+// Issue 33: bit-identical finite inputs (a render equal to its baseline) skip SSIM's filtering and
+// PSNR's loop; the skipped result is the evaluated one bit for bit (SSIM 1.0 per channel, PSNR
+// +inf with MSE, RMSE and max_abs +0.0), on goldens, an HDR image with a 1e4 highlight, tiny values
+// and an LDR image. An image with a NaN is not skipped (its figures stay NaN).
+TEST(SsimPsnr, IdenticalInputsSkipWithTheSameResult) {
+    using testing_support::synthetic;
+    std::vector<cv::Mat> images;
+    for (const char* g :
+         {"goldens/baseline/mobile.roughness_sweep.sky_sun.default.exr", "goldens/reference/furnace__constant-1.exr"})
+        images.push_back(display_transform(read_image(std::string(IBLCHECK_SOURCE_DIR) + "/" + g).pixels));
+    cv::Mat hdr = synthetic(97, 61, 3, 0.1f) * 8.0;
+    hdr.at<cv::Vec3f>(10, 20) = cv::Vec3f(1e4f, 9e3f, 8e3f);
+    images.push_back(display_transform(hdr));
+    images.push_back(synthetic(64, 48, 5, 0.0f) * 1e-30);
+    images.push_back(synthetic(40, 33, 7, 0.05f));
+    for (const cv::Mat& img : images) {
+        ASSERT_FALSE(img.empty());
+        const SsimResult s = compute_ssim(img, img.clone()), se = compute_ssim(img, img.clone(), false);
+        EXPECT_EQ(std::memcmp(&s, &se, sizeof s), 0) << se.mean;
+        EXPECT_EQ(se.mean, 1.0); // what the skip assumes
+        const PsnrResult p = compute_psnr(img, img.clone()), pe = compute_psnr(img, img.clone(), 1.0, false);
+        EXPECT_EQ(std::memcmp(&p, &pe, sizeof p), 0) << pe.db << " " << pe.rmse;
+        EXPECT_TRUE(std::isinf(pe.db));
+    }
+    cv::Mat nan = synthetic(32, 32, 9, 0.0f);
+    nan.at<cv::Vec3f>(16, 16)[1] = std::nanf("");
+    EXPECT_TRUE(std::isnan(compute_ssim(nan, nan.clone()).mean));
+    EXPECT_TRUE(std::isnan(compute_psnr(nan, nan.clone()).rmse));
+}

@@ -276,6 +276,80 @@ TEST(PrecomputeStore, AChangedInputMisses) {
     EXPECT_NE(other_cpu, key);
 }
 
+namespace {
+
+// The instruction count a render of `spec` reports, with a fresh renderer, no stored precompute,
+// and the cost store at `store` ("0": off).
+json counted_cost(const TestSpec& spec, const std::string& store) {
+    setenv("IBLCHECK_COST_CACHE", store.c_str(), 1);
+    const RenderResult r = fresh_render(spec, "0");
+    unsetenv("IBLCHECK_COST_CACHE");
+    return r.provenance["cost"]["spirv_instructions_per_pixel"];
+}
+
+// Every entry of the cost store made to hold `planted` (its last 8 bytes: the count's bits).
+void plant(const fs::path& dir, double planted) {
+    for (const auto& e : fs::directory_iterator(dir)) {
+        std::fstream f(e.path(), std::ios::in | std::ios::out | std::ios::binary);
+        f.seekp(std::streamoff(fs::file_size(e.path()) - sizeof planted));
+        f.write(reinterpret_cast<const char*>(&planted), sizeof planted);
+    }
+}
+
+size_t entries(const fs::path& dir) {
+    return fs::exists(dir) ? size_t(std::distance(fs::directory_iterator(dir), fs::directory_iterator())) : 0u;
+}
+
+} // namespace
+
+// A stored instruction count is the one the twin counts (compute, fragment and sampled shading):
+// warm equals cold bit for bit. Then every entry is made to hold a planted figure: a render with the
+// same inputs reports it (the count is read, not counted again), and a render whose option, scene,
+// size, environment or shader include changed does not (it misses, counts, and stores an entry).
+TEST(CostStore, AStoredCountIsTheCountedOneAndAChangedInputMisses) {
+    const fs::path dir = temp_dir("cost_store");
+    TestSpec sampled = furnace_spec({});
+    sampled.method = "sampled";
+    sampled.options = OptionMap();
+    sampled.options.set("cube_size", "32");
+    sampled.options.set("samples", "4");
+    const std::vector<TestSpec> specs = {furnace_spec({}), furnace_spec({{"shading", "fragment"}}), sampled};
+    for (const TestSpec& spec : specs) {
+        const json cold = counted_cost(spec, "0");
+        ASSERT_TRUE(cold.is_number()) << spec.method << " " << spec.options.canonical();
+        EXPECT_EQ(counted_cost(spec, dir.string()), cold); // counts and stores
+        EXPECT_EQ(counted_cost(spec, dir.string()), cold); // reads
+    }
+    ASSERT_EQ(entries(dir), specs.size());
+
+    plant(dir, 12345.0);
+    for (const TestSpec& spec : specs) EXPECT_EQ(counted_cost(spec, dir.string()), json(12345.0)) << spec.method;
+
+    TestSpec option = furnace_spec({{"mix_begin_roughness", "0.05"}}), scene = furnace_spec({}), size = furnace_spec({}),
+             env = furnace_spec({});
+    scene.scene = "sphere";
+    size.width = 48;
+    size.height = 40;
+    env.env = "sky_sun";
+    for (const TestSpec* changed : {&option, &scene, &size, &env}) {
+        const json c = counted_cost(*changed, dir.string());
+        EXPECT_TRUE(c.is_number() && c != json(12345.0)) << changed->scene << " " << changed->options.canonical() << ": " << c;
+    }
+    EXPECT_EQ(entries(dir), specs.size() + 4);
+
+    // An include of the shading (split_sum.glsl) gained a comment: the same count, under a new key.
+    const fs::path shaders = temp_dir("cost_store_shaders");
+    fs::copy(vk::shader_dir(), shaders, fs::copy_options::recursive);
+    std::ofstream(shaders / "split_sum.glsl", std::ios::app) << "\n// edited\n";
+    setenv("IBLCHECK_SHADER_DIR", shaders.c_str(), 1);
+    const json edited = counted_cost(specs[0], dir.string());
+    unsetenv("IBLCHECK_SHADER_DIR");
+    fs::remove_all(shaders);
+    EXPECT_TRUE(edited.is_number() && edited != json(12345.0)) << edited;
+    EXPECT_EQ(entries(dir), specs.size() + 5);
+    fs::remove_all(dir);
+}
+
 // `--version` reads the commit from iblcheck_commit.txt beside the binary (written at every build),
 // so a bisect step whose commit (or a shader edit's dirty state) changed relinks nothing; compiled
 // in, it recompiled version.cpp and relinked the tool at every step. Without the file: "unknown".

@@ -2,6 +2,7 @@
 
 #include <cstring>
 
+#include "cost_store.h"
 #include "harness/common/errors.h"
 #include "harness/common/profile.h"
 #include "renderers/mobile/descriptor_types.h"
@@ -32,6 +33,19 @@ void record_draw(VkCommandBuffer cmd, const vk::GraphicsPipeline& p, const vk::O
     target.end(cmd);
     if (timer) timer->end(cmd);
 }
+// The store's key of the draw's count: its inputs, the counted modules' source hashes, the target and
+// the timed draw's resolved image.
+std::string fragment_cost_key(GpuSession& gpu, const FragmentShadingPass& pass, const ShadePush& push,
+                              const vk::TargetFormat& format, const vk::CompileOptions& counting, const vk::Buffer& out) {
+    return cost_store_key(
+        gpu,
+        {"fragment", pass.inputs_hash, vk::compile_shader("shade_spheres.vert", pass.defines, counting).source_hash,
+         vk::compile_shader("shade_spheres.frag", pass.defines, counting).source_hash, bytes_hash(&push, sizeof push),
+         std::to_string(pass.sphere_count),
+         std::to_string(int(format.color)) + "/" + std::to_string(int(format.depth)) + "/" + std::to_string(int(format.samples)),
+         bytes_hash(out.mapped, size_t(out.size))});
+}
+
 } // namespace
 
 double box_downsample_rgba(const float* rgba, int width, int height, int ssaa, cv::Mat& rgb) {
@@ -92,6 +106,13 @@ FragmentShadingResult shade_fragment(GpuSession& gpu, const FragmentShadingPass&
         ProfileStage stage("counting_twin");
         vk::CompileOptions counting = pass.options;
         counting.count_instructions = true;
+        const std::string key =
+            pass.inputs_hash.empty() ? std::string() : fragment_cost_key(gpu, pass, push, format, counting, out);
+        if (!key.empty())
+            if (std::optional<double> stored = load_cost(key)) {
+                r.instructions_per_pixel = stored;
+                return r;
+            }
         const vk::GraphicsPipeline& counted = gpu.graphics_pipeline("shade_spheres.vert", "shade_spheres.frag", pass.defines,
                                                                     kTypes, sizeof push, format, counting);
         vk::OffscreenTarget scratch_target(ctx, fw, fh, format);
@@ -107,6 +128,7 @@ FragmentShadingResult shade_fragment(GpuSession& gpu, const FragmentShadingPass&
             throw Error("shade_spheres.frag: the instruction-counting twin drew another image than the timed draw; "
                         "its count would not describe the frame");
         r.instructions_per_pixel = double(*total.as<uint64_t>()) / (double(width) * height);
+        if (!key.empty()) save_cost(key, *r.instructions_per_pixel);
     }
     return r;
 }

@@ -22,6 +22,9 @@ struct FragmentShadingPass {
     std::vector<vk::Binding> bindings; // 0..4 as the compute pass binds them (no output buffer)
     ShadePush push;                    // width, height: the image; ssaa: supersampling factor
     uint32_t sphere_count = 0;
+    // shading_inputs_hash() of what the bindings hold: the count is stored under it (cost_store.h);
+    // empty: counted every time.
+    std::string inputs_hash;
 };
 
 struct FragmentShadingResult {

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <optional>
 
+#include "cost_store.h"
 #include "fragment_shading.h"
 #include "gpu_scene.h"
 #include "harness/common/errors.h"
@@ -127,13 +128,15 @@ struct ShadingInputs {
     std::vector<vk::Binding> bindings;
     ShadePush push;
     uint32_t sphere_count;
-    double per_hit; // texture samples per shading
+    double per_hit;          // texture samples per shading
+    std::string inputs_hash; // of the precompute and the scene: the stored count's key (cost_store.h)
 };
 
 // shading=fragment into `result` (image, timings, texture fetches); returns its instruction count.
 std::optional<double> shade_with_fragments(GpuSession& gpu, const ShadingInputs& in, RenderResult& result) {
     ProfileStage stage("shading");
-    FragmentShadingResult f = shade_fragment(gpu, {in.defines, in.options, in.bindings, in.push, in.sphere_count});
+    FragmentShadingResult f =
+        shade_fragment(gpu, {in.defines, in.options, in.bindings, in.push, in.sphere_count, in.inputs_hash});
     result.image = f.image;
     result.non_finite_coverage = f.non_finite_coverage;
     result.timings.insert(result.timings.end(), f.timings.begin(), f.timings.end());
@@ -158,7 +161,7 @@ std::optional<double> shade_with_compute(GpuSession& gpu, const ShadingInputs& i
     // One shading per ray that hits.
     result.texture_fetches_per_pixel = coverage * pc.ssaa * pc.ssaa * in.per_hit;
     return shading_instructions_per_pixel(
-        gpu, {"shade_spheres.comp", in.defines, types, in.options, b, 5, &pc, sizeof pc, width, height}, out);
+        gpu, {"shade_spheres.comp", in.defines, types, in.options, b, 5, &pc, sizeof pc, width, height, in.inputs_hash}, out);
 }
 
 nlohmann::json mobile_provenance(const MobileOptions& m, const IblResources& ibl, bool cached, std::optional<double> instructions,
@@ -220,6 +223,7 @@ RenderResult render_mobile(GpuSession& gpu, const Environment& env, const TestSp
     in.push = shade_push(o, width, height, m.ps, ibl);
     in.bindings = shading_bindings(ctx, scene_buf, ibl);
     in.sphere_count = uint32_t(scene.spheres.size());
+    in.inputs_hash = shading_inputs_hash(gpu, env, m.ps, scene_buf);
     const bool fragment = m.variant.at("shading") == "fragment";
     in.per_hit = contract ? contract_samples_per_hit(in.defines, in.options, fragment) : texture_samples_per_hit(m);
 

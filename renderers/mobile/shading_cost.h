@@ -23,12 +23,16 @@ struct ShadingPass {
     const void* push = nullptr;
     uint32_t push_bytes = 0;
     int width = 0, height = 0; // image size; the dispatch is 8x8 workgroups over it
+    // shading_inputs_hash() of what the bindings hold besides the output: the count is stored under
+    // it (cost_store.h) and read in a later run; empty: counted every time.
+    std::string inputs_hash;
 };
 
 // Dynamic SPIR-V instructions of the whole dispatch (every invocation, every ssaa ray) per image
 // pixel. The instrumented twin writes a scratch image, which must equal `out` (what the timed pass
 // wrote) bit for bit: otherwise the count would describe another computation and this throws
-// Error. nullopt when the device cannot count (no shaderInt64 + shaderBufferInt64Atomics).
+// Error. nullopt when the device cannot count (no shaderInt64 + shaderBufferInt64Atomics). A count
+// stored for the same inputs (cost_store.h) is returned without the twin.
 std::optional<double> shading_instructions_per_pixel(GpuSession& gpu, const ShadingPass& pass, const vk::Buffer& out);
 
 // The render's provenance entry "cost": {"spirv_instructions_per_pixel": X or null,

@@ -4,6 +4,7 @@
 
 #include "harness/common/errors.h"
 #include "harness/common/profile.h"
+#include "renderers/mobile/cost_store.h"
 #include "renderers/mobile/gpu_scene.h"
 #include "renderers/mobile/ibl_precompute.h"
 #include "renderers/mobile/push_constants.h"
@@ -64,8 +65,19 @@ RenderResult render_sampled(GpuSession& gpu, const Environment& env, const TestS
         result.timings.push_back({name, ms, true, false});
     double coverage = read_back_image(out, width, height, result.image, "shade_sampled.comp", result.non_finite_coverage);
     result.texture_fetches_per_pixel = coverage * pc.ssaa * pc.ssaa * samples;
-    auto instructions =
-        shading_instructions_per_pixel(gpu, {"shade_sampled.comp", defines, types, {}, b, 5, &pc, sizeof pc, width, height}, out);
+    auto instructions = shading_instructions_per_pixel(gpu,
+                                                       {"shade_sampled.comp",
+                                                        defines,
+                                                        types,
+                                                        {},
+                                                        b,
+                                                        5,
+                                                        &pc,
+                                                        sizeof pc,
+                                                        width,
+                                                        height,
+                                                        shading_inputs_hash(gpu, env, ps, scene_buf)},
+                                                       out);
     result.shader_instructions_per_pixel = instructions.value_or(0);
     result.provenance = {{"method", "sampled"}, {"precompute_cached", cached},
                          {"samples", samples},  {"cube_size", ps.cube_size},

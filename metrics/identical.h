@@ -1,0 +1,24 @@
+// Bit-identical finite images (a render equal to its baseline, the usual pass): every metric's
+// result for them is known exactly, so FLIP, SSIM and PSNR skip their work (issue 33).
+#pragma once
+#include <opencv2/core.hpp>
+
+#include <cmath>
+#include <cstring>
+
+namespace iblcheck {
+
+// Same size, type and bytes (float), and no NaN or Inf (whose error is not 0).
+inline bool identical_finite(const cv::Mat& a, const cv::Mat& b) {
+    if (a.size() != b.size() || a.type() != b.type() || a.depth() != CV_32F) return false;
+    for (int y = 0; y < a.rows; ++y) {
+        const float* p = a.ptr<float>(y);
+        const size_t n = size_t(a.cols) * a.channels();
+        if (p != b.ptr<float>(y) && std::memcmp(p, b.ptr<float>(y), n * sizeof(float)) != 0) return false;
+        for (size_t i = 0; i < n; ++i)
+            if (!std::isfinite(p[i])) return false;
+    }
+    return true;
+}
+
+} // namespace iblcheck

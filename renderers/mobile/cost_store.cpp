@@ -1,0 +1,88 @@
+#include "cost_store.h"
+
+#include <unistd.h>
+
+#include <cstring>
+#include <fstream>
+#include <thread>
+
+#include "harness/common/hash.h"
+#include "precompute_store.h"
+#include "renderers/vulkan/cpu_caps.h"
+#include "renderers/vulkan/shader_compiler.h"
+
+namespace fs = std::filesystem;
+
+namespace iblcheck {
+
+namespace {
+
+constexpr char kMagic[] = "IBLCOST1"; // this layout; another is a miss
+
+fs::path entry_path(const std::string& key) { return cost_store_dir() / (key + ".cost"); }
+
+} // namespace
+
+fs::path cost_store_dir() {
+    if (const char* dir = std::getenv("IBLCHECK_COST_CACHE"); dir && *dir)
+        return std::string(dir) == "0" ? fs::path() : fs::path(dir);
+    return vk::spirv_cache_dir().parent_path() / "cost";
+}
+
+std::string bytes_hash(const void* data, size_t n) {
+    Fnv1a64 h;
+    h.update(data, n);
+    return h.hex() + ":" + std::to_string(n);
+}
+
+std::string shading_inputs_hash(GpuSession& gpu, const Environment& env, const PrecomputeSettings& s,
+                                const vk::Buffer& scene_buf) {
+    return precompute_store_key(gpu, env, s) + "/scene=" + bytes_hash(scene_buf.mapped, size_t(scene_buf.size));
+}
+
+std::string cost_store_key(GpuSession& gpu, const std::vector<std::string>& parts) {
+    Fnv1a64 h;
+    h.update(std::string(kMagic) + ";");
+    for (const std::string& p : parts) h.update(std::to_string(p.size()) + ":" + p + ";");
+    const vk::DeviceInfo& i = gpu.ctx().info();
+    h.update(i.device_name + ";" + i.driver_name + ";" + i.driver_info + ";" + i.api_version + ";");
+    h.update(llvmpipe_caps().cpu_class());
+    return h.hex();
+}
+
+std::optional<double> load_cost(const std::string& key) {
+    if (cost_store_dir().empty()) return std::nullopt;
+    std::ifstream f(entry_path(key), std::ios::binary);
+    if (!f) return std::nullopt;
+    const std::string bytes((std::istreambuf_iterator<char>(f)), {});
+    // The magic, the key again (a renamed or misplaced file is a miss), the double's bits.
+    const std::string head = std::string(kMagic) + key;
+    if (bytes.size() != head.size() + sizeof(double) || bytes.compare(0, head.size(), head) != 0) return std::nullopt;
+    double v = 0;
+    std::memcpy(&v, bytes.data() + head.size(), sizeof v);
+    if (!(v >= 0)) return std::nullopt; // a count is finite and not negative
+    return v;
+}
+
+void save_cost(const std::string& key, double instructions_per_pixel) {
+    if (cost_store_dir().empty()) return;
+    std::string bytes = std::string(kMagic) + key;
+    bytes.append(reinterpret_cast<const char*>(&instructions_per_pixel), sizeof instructions_per_pixel);
+    std::error_code ec;
+    fs::create_directories(cost_store_dir(), ec);
+    const fs::path file = entry_path(key);
+    const fs::path tmp = fs::path(file).concat(".tmp" + std::to_string(::getpid()) + "-" +
+                                               std::to_string(std::hash<std::thread::id>{}(std::this_thread::get_id())));
+    {
+        std::ofstream o(tmp, std::ios::binary);
+        o.write(bytes.data(), std::streamsize(bytes.size()));
+        if (!o) {
+            fs::remove(tmp, ec);
+            return;
+        }
+    }
+    fs::rename(tmp, file, ec);
+    if (ec) fs::remove(tmp, ec);
+}
+
+} // namespace iblcheck
