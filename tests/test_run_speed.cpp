@@ -9,14 +9,18 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <set>
 #include <string>
 
+#include "harness/common/hash.h"
 #include "harness/common/profile.h"
+#include "harness/common/program.h"
 #include "harness/runner.h"
 #include "harness/suite.h"
 #include "renderers/environments/environment.h"
+#include "renderers/mobile/cost_store.h"
 #include "renderers/mobile/precompute_store.h"
 #include "renderers/renderer.h"
 #include "renderers/vulkan/shader_compiler.h"
@@ -274,6 +278,32 @@ TEST(PrecomputeStore, AChangedInputMisses) {
     const std::string other_cpu = precompute_store_key(gpu, studio, s);
     unsetenv("GALLIUM_OVERRIDE_CPU_CAPS");
     EXPECT_NE(other_cpu, key);
+
+    // Another build of the tool (a bisect step across a C++ change shares .cache/ with the last one).
+    EXPECT_EQ(precompute_store_key(gpu, studio, s, running_binary_hash()), key);
+    EXPECT_NE(precompute_store_key(gpu, studio, s, "another build"), key);
+    EXPECT_EQ(cost_store_key(gpu, {"pass"}, running_binary_hash()), cost_store_key(gpu, {"pass"}));
+    EXPECT_NE(cost_store_key(gpu, {"pass"}, "another build"), cost_store_key(gpu, {"pass"}));
+}
+
+// The stores' tool part is the running binary's content: the hash of /proc/self/exe read here on its
+// own, and a one-byte change to a file changes a file's hash.
+TEST(PrecomputeStore, ToolPartIsTheRunningBinarysContent) {
+    std::ifstream exe("/proc/self/exe", std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(exe)), std::istreambuf_iterator<char>());
+    ASSERT_GT(bytes.size(), 1000u);
+    Fnv1a64 h;
+    h.update(bytes);
+    EXPECT_EQ(running_binary_hash(), h.hex());
+
+    const fs::path dir = temp_dir("tool_hash");
+    std::string copy = bytes.substr(0, 4096);
+    std::ofstream(dir / "a", std::ios::binary) << copy;
+    copy[2048] ^= 1;
+    std::ofstream(dir / "b", std::ios::binary) << copy;
+    EXPECT_NE(file_content_hash((dir / "a").string()), file_content_hash((dir / "b").string()));
+    EXPECT_EQ(file_content_hash((dir / "missing").string()), "");
+    fs::remove_all(dir);
 }
 
 namespace {

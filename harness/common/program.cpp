@@ -2,10 +2,13 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <sstream>
+#include <vector>
 
 #include <unistd.h>
 
+#include "harness/common/hash.h"
 #include "harness/common/shell_quote.h"
 
 namespace fs = std::filesystem;
@@ -45,6 +48,23 @@ std::string program_from_self() {
     if (!rel.empty() && rel.find('/') == std::string::npos) rel = "./" + rel; // a bare name would search PATH
     const std::string best = !rel.empty() && rel.size() < self.string().size() ? rel : self.string();
     return shell_arg(best);
+}
+
+std::string file_content_hash(const std::string& path) {
+    std::ifstream f(path, std::ios::binary);
+    if (!f) return "";
+    Fnv1a64 h;
+    std::vector<char> buf(1 << 20);
+    while (f.read(buf.data(), std::streamsize(buf.size())) || f.gcount() > 0) h.update(buf.data(), size_t(f.gcount()));
+    return f.bad() ? "" : h.hex();
+}
+
+const std::string& running_binary_hash() {
+    static const std::string hash = [] {
+        std::string h = file_content_hash("/proc/self/exe");
+        return h.empty() ? std::string("unreadable") : h;
+    }();
+    return hash;
 }
 
 } // namespace iblcheck

@@ -16,4 +16,15 @@ void set_program_name(const std::string& name);
 // ("build/iblcheck", "./iblcheck"), else the absolute path; shell-quoted when it needs it.
 std::string program_from_self();
 
+// The content hash (FNV-1a 64, hex) of the file at `path`; empty when it cannot be read.
+std::string file_content_hash(const std::string& path);
+
+// The running binary's content hash (/proc/self/exe), computed once: the part of the on-disk stores'
+// keys (precompute_store.h, cost_store.h) that stands for the tool's own C++ (ASTC encoding, SH
+// projection, the counting pass's host side). Without it an entry made by another build of the tool
+// was read back: a bisect across a C++ change, whose steps share .cache/, judged each commit with the
+// first one's precompute. A shader-only change relinks nothing and keeps the hash (shaders are keyed
+// by content on their own). "unreadable" when /proc/self/exe cannot be read (every build then shares it).
+const std::string& running_binary_hash();
+
 } // namespace iblcheck

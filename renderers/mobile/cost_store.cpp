@@ -40,8 +40,9 @@ std::string shading_inputs_hash(GpuSession& gpu, const Environment& env, const P
     return precompute_store_key(gpu, env, s) + "/scene=" + bytes_hash(scene_buf.mapped, size_t(scene_buf.size));
 }
 
-std::string cost_store_key(GpuSession& gpu, const std::vector<std::string>& parts) {
+std::string cost_store_key(GpuSession& gpu, const std::vector<std::string>& parts, const std::string& tool) {
     Fnv1a64 h;
+    h.update("tool=" + tool + ";");
     h.update(std::string(kMagic) + ";");
     for (const std::string& p : parts) h.update(std::to_string(p.size()) + ":" + p + ";");
     const vk::DeviceInfo& i = gpu.ctx().info();

@@ -122,8 +122,9 @@ fs::path precompute_store_dir() {
     return vk::spirv_cache_dir().parent_path() / "precompute";
 }
 
-std::string precompute_store_key(GpuSession& gpu, const Environment& env, const PrecomputeSettings& s) {
+std::string precompute_store_key(GpuSession& gpu, const Environment& env, const PrecomputeSettings& s, const std::string& tool) {
     Fnv1a64 h;
+    h.update("tool=" + tool + ";");
     h.update(std::to_string(kMagic) + ";" + precompute_key(env.content_hash, s) + ";");
     for (const char* shader : kPassShaders)
         h.update(std::string(shader) + "=" + vk::file_tree_hash(vk::shader_dir() / shader) + ";");
