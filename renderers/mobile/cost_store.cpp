@@ -1,10 +1,7 @@
 #include "cost_store.h"
 
-#include <unistd.h>
-
 #include <cstring>
 #include <fstream>
-#include <thread>
 
 #include "harness/common/hash.h"
 #include "precompute_store.h"
@@ -69,21 +66,7 @@ void save_cost(const std::string& key, double instructions_per_pixel) {
     if (cost_store_dir().empty()) return;
     std::string bytes = std::string(kMagic) + key;
     bytes.append(reinterpret_cast<const char*>(&instructions_per_pixel), sizeof instructions_per_pixel);
-    std::error_code ec;
-    fs::create_directories(cost_store_dir(), ec);
-    const fs::path file = entry_path(key);
-    const fs::path tmp = fs::path(file).concat(".tmp" + std::to_string(::getpid()) + "-" +
-                                               std::to_string(std::hash<std::thread::id>{}(std::this_thread::get_id())));
-    {
-        std::ofstream o(tmp, std::ios::binary);
-        o.write(bytes.data(), std::streamsize(bytes.size()));
-        if (!o) {
-            fs::remove(tmp, ec);
-            return;
-        }
-    }
-    fs::rename(tmp, file, ec);
-    if (ec) fs::remove(tmp, ec);
+    write_store_entry(entry_path(key), bytes);
 }
 
 } // namespace iblcheck

@@ -192,14 +192,17 @@ void save_precompute(vk::Context& ctx, const std::string& key, const IblResource
     put_image(ctx, w, r.lut);
     put_image(ctx, w, r.irradiance);
     w.put(kEndMark);
+    write_store_entry(entry_path(key), w.bytes);
+}
+
+void write_store_entry(const fs::path& file, std::string_view bytes) {
     std::error_code ec;
-    fs::create_directories(precompute_store_dir(), ec);
-    const fs::path file = entry_path(key);
+    fs::create_directories(file.parent_path(), ec);
     const fs::path tmp = fs::path(file).concat(".tmp" + std::to_string(::getpid()) + "-" +
                                                std::to_string(std::hash<std::thread::id>{}(std::this_thread::get_id())));
     {
         std::ofstream o(tmp, std::ios::binary);
-        o.write(w.bytes.data(), std::streamsize(w.bytes.size()));
+        o.write(bytes.data(), std::streamsize(bytes.size()));
         if (!o) {
             fs::remove(tmp, ec);
             return;
