@@ -10,6 +10,7 @@
 
 #include "harness/common/name_filter.h"
 #include "harness/common/shell_quote.h"
+#include "reports/report_html.h"
 
 using nlohmann::json;
 
@@ -17,14 +18,8 @@ namespace iblcheck::report {
 
 namespace {
 
-std::string text_of(const json& j, const char* k) {
-    auto it = j.find(k);
-    return j.is_object() && it != j.end() && it->is_string() ? it->get<std::string>() : std::string();
-}
-const json& child(const json& j, const char* k) {
-    static const json null;
-    return j.is_object() && j.contains(k) ? j[k] : null;
-}
+using html::str;
+using html::sub;
 
 // "baseline; reference": the comparisons that did not pass, or for a test without one (an error, a
 // missing golden) the first part of its message, cut at the first digit (values differ, causes not).
@@ -32,12 +27,11 @@ const json& child(const json& j, const char* k) {
 // not on others; the group counts them instead (failing_metrics).
 std::string failing_kinds(const json& t) {
     std::string out;
-    if (child(t, "comparisons").is_array())
+    if (sub(t, "comparisons").is_array())
         for (const json& c : t["comparisons"])
-            if (text_of(c, "verdict") != "pass" && !text_of(c, "verdict").empty())
-                out += (out.empty() ? "" : "; ") + text_of(c, "kind");
+            if (str(c, "verdict") != "pass" && !str(c, "verdict").empty()) out += (out.empty() ? "" : "; ") + str(c, "kind");
     if (out.empty()) {
-        std::string m = text_of(t, "message").substr(0, text_of(t, "message").find("; "));
+        std::string m = str(t, "message").substr(0, str(t, "message").find("; "));
         out = m.substr(0, m.find_first_of("0123456789"));
     }
     return out;
@@ -46,24 +40,24 @@ std::string failing_kinds(const json& t) {
 // "baseline flip.mean", one per check that did not pass.
 std::vector<std::string> failing_metrics(const json& t) {
     std::vector<std::string> out;
-    if (child(t, "comparisons").is_array())
+    if (sub(t, "comparisons").is_array())
         for (const json& c : t["comparisons"])
-            if (child(c, "checks").is_array() && text_of(c, "verdict") != "pass")
+            if (sub(c, "checks").is_array() && str(c, "verdict") != "pass")
                 for (const json& k : c["checks"])
-                    if (text_of(k, "status") != "pass" && !text_of(k, "status").empty())
-                        out.push_back(text_of(c, "kind") + " " + text_of(k, "metric"));
+                    if (str(k, "status") != "pass" && !str(k, "status").empty())
+                        out.push_back(str(c, "kind") + " " + str(k, "metric"));
     return out;
 }
 
 // What changed in the shaders since the test's baseline was blessed: by file where both the
 // sidecar and the render recorded per-file hashes, else the tree hash; "" when nothing did.
 std::string shader_change(const json& t) {
-    const json& now = child(t, "provenance");
-    if (!child(t, "comparisons").is_array()) return "";
+    const json& now = sub(t, "provenance");
+    if (!sub(t, "comparisons").is_array()) return "";
     for (const json& c : t["comparisons"]) {
-        const json& a = child(c, "approved");
-        if (text_of(c, "kind") != "baseline" || !a.is_object()) continue;
-        const json &fa = child(a, "shader_files"), &fn = child(now, "shader_files");
+        const json& a = sub(c, "approved");
+        if (str(c, "kind") != "baseline" || !a.is_object()) continue;
+        const json &fa = sub(a, "shader_files"), &fn = sub(now, "shader_files");
         if (fa.is_object() && fn.is_object()) {
             std::set<std::string> files;
             for (auto& [f, h] : fa.items())
@@ -74,30 +68,30 @@ std::string shader_change(const json& t) {
             for (const std::string& f : files) s += (s.empty() ? "" : ", ") + f;
             return s.empty() ? "" : s + " changed";
         }
-        const std::string was = text_of(a, "shader_tree_hash"), is = text_of(now, "shader_tree_hash");
+        const std::string was = str(a, "shader_tree_hash"), is = str(now, "shader_tree_hash");
         if (!was.empty() && !is.empty() && was != is) return "shader tree " + was.substr(0, 8) + " -> " + is.substr(0, 8);
     }
     return "";
 }
 
 double baseline_flip(const json& t) {
-    if (child(t, "comparisons").is_array())
+    if (sub(t, "comparisons").is_array())
         for (const json& c : t["comparisons"])
-            if (text_of(c, "kind") == "baseline" && child(child(child(c, "metrics"), "flip"), "mean").is_number())
+            if (str(c, "kind") == "baseline" && sub(sub(sub(c, "metrics"), "flip"), "mean").is_number())
                 return c["metrics"]["flip"]["mean"].get<double>();
     return -1;
 }
 
 std::string worst_sphere(const json& t) {
-    if (child(t, "comparisons").is_array())
+    if (sub(t, "comparisons").is_array())
         for (const json& c : t["comparisons"])
-            if (std::string s = text_of(child(c, "worst_block"), "sphere"); !s.empty()) return s;
+            if (std::string s = str(sub(c, "worst_block"), "sphere"); !s.empty()) return s;
     return "";
 }
 
 std::string option_keys(const json& t) {
     std::string k;
-    if (child(t, "options").is_object())
+    if (sub(t, "options").is_object())
         for (auto& [key, v] : t["options"].items()) k += (k.empty() ? "" : "+") + key;
     return k.empty() ? "default" : k;
 }
@@ -219,7 +213,7 @@ std::string covering_filter(const std::vector<std::string>& members, const std::
 }
 
 bool ran_whole_suite(const json& results) {
-    const std::string cmd = text_of(results, "command"), shard = text_of(results, "shard");
+    const std::string cmd = str(results, "command"), shard = str(results, "shard");
     return cmd.find(" --filter") == std::string::npos && cmd.find(" --shard") == std::string::npos &&
            (shard.empty() || shard == "0/1");
 }
@@ -231,7 +225,7 @@ std::vector<FailureGroup> group_failures(const std::vector<const json*>& tests, 
     std::map<std::tuple<std::string, std::string, std::string>, std::map<std::string, int>> metric_tally;
     for (size_t i = 0; i < tests.size(); ++i) {
         const json& t = *tests[i];
-        const std::string v = text_of(t, "verdict");
+        const std::string v = str(t, "verdict");
         if (v == "pass" || v.empty()) continue;
         const auto key = std::make_tuple(v, failing_kinds(t), shader_change(t));
         FailureGroup& g = by_key[key];
@@ -244,7 +238,7 @@ std::vector<FailureGroup> group_failures(const std::vector<const json*>& tests, 
         tallies[key].second[option_keys(t)]++;
     }
     std::vector<std::string> all;
-    for (const json* t : tests) all.push_back(text_of(*t, "name"));
+    for (const json* t : tests) all.push_back(str(*t, "name"));
 
     std::vector<FailureGroup> out;
     for (auto& [key, g] : by_key) {
@@ -275,7 +269,7 @@ std::string group_bless_line(const std::vector<const json*>& tests, const Failur
                              const std::string& shader_arg) {
     if (g.verdict != "fail" && g.verdict != "missing-golden" && g.verdict != "improved") return "";
     std::string program = "iblcheck", goldens;
-    const std::string b = g.members.empty() ? "" : text_of(*tests[g.members[0]], "bless_command");
+    const std::string b = g.members.empty() ? "" : str(*tests[g.members[0]], "bless_command");
     if (b.empty()) return "";
     // The binary and golden store the members' own bless commands name (the ones that ran).
     if (b.find(" bless --suite ") != std::string::npos) program = b.substr(0, b.find(" bless --suite "));
