@@ -7,10 +7,10 @@
 #include <thread>
 
 #include "golden_store.h"
-#include "harness/common/profile.h"
 #include "image_compare.h"
+#include "image_io/image_io.h"
+#include "kernel/profile.h"
 #include "metrics/display_transform.h"
-#include "metrics/image_io.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;

@@ -13,12 +13,12 @@
 #include <regex>
 
 #include "golden_store.h"
-#include "harness/common/errors.h"
-#include "harness/common/input_file.h"
-#include "harness/common/program.h"
-#include "harness/common/shell_quote.h"
 #include "image_compare.h"
-#include "metrics/image_io.h"
+#include "image_io/image_io.h"
+#include "kernel/errors.h"
+#include "kernel/input_file.h"
+#include "kernel/program.h"
+#include "kernel/shell_quote.h"
 #include "provenance.h"
 #include "renderers/environments/environment.h"
 #include "verdict.h"

@@ -8,7 +8,7 @@
 #include <optional>
 #include <string>
 
-#include "harness/common/program.h"
+#include "kernel/program.h"
 #include "suite.h"
 
 namespace iblcheck {

@@ -12,8 +12,8 @@
 #include <sstream>
 #include <vector>
 
-#include "harness/common/errors.h"
-#include "metrics/image_io.h"
+#include "image_io/image_io.h"
+#include "kernel/errors.h"
 
 extern char** environ;
 

@@ -25,7 +25,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 
-#include "harness/common/options.h"
+#include "kernel/options.h"
 #include "renderers/render_api.h"
 
 namespace iblcheck {

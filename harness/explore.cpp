@@ -8,7 +8,7 @@
 
 #include <fmt/format.h>
 
-#include "harness/common/errors.h"
+#include "kernel/errors.h"
 #include "renderers/option_table.h"
 
 namespace iblcheck {

@@ -19,7 +19,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "harness/common/options.h"
+#include "kernel/options.h"
 
 namespace iblcheck {
 

@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "harness/common/profile.h"
+#include "kernel/profile.h"
 #include "renderers/renderer.h"
 
 using nlohmann::json;

@@ -6,9 +6,9 @@
 #include <cstring>
 
 #include "bless.h"
-#include "harness/common/errors.h"
-#include "harness/common/profile.h"
 #include "image_compare.h"
+#include "kernel/errors.h"
+#include "kernel/profile.h"
 #include "provenance.h"
 
 namespace fs = std::filesystem;

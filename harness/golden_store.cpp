@@ -9,13 +9,13 @@
 #include <sstream>
 #include <unistd.h>
 
-#include "harness/common/errors.h"
-#include "harness/common/input_file.h"
-#include "harness/common/profile.h"
-#include "harness/common/program.h"
-#include "harness/common/shell_quote.h"
-#include "metrics/image_formats.h"
-#include "metrics/image_io.h"
+#include "image_io/image_formats.h"
+#include "image_io/image_io.h"
+#include "kernel/errors.h"
+#include "kernel/input_file.h"
+#include "kernel/profile.h"
+#include "kernel/program.h"
+#include "kernel/shell_quote.h"
 #include "renderers/environments/environment.h"
 
 namespace fs = std::filesystem;

@@ -43,7 +43,7 @@ class GoldenStore {
     std::filesystem::path baseline_path(const std::string& test_name, const std::string& label = "") const;
     std::filesystem::path reference_path(const TestSpec& spec) const;
     // The temporal truth of a sequence of `frames` frames: reference/<key>__frames=N.exr, the frames
-    // stacked vertically (renderers/reference/truth_golden.h), split into frames; nullopt when absent.
+    // stacked vertically (harness/truth/truth_golden.h), split into frames; nullopt when absent.
     // Throws InputError naming the file when it is corrupt, has no sidecar or NaN/Inf pixels, or its
     // height is not a multiple of `frames`.
     std::optional<Golden> reference_sequence(const TestSpec& spec, int frames, std::vector<cv::Mat>& out) const;

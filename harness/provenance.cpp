@@ -1,7 +1,7 @@
 #include "provenance.h"
 
 #include "golden_store.h"
-#include "renderers/vulkan/cpu_caps.h"
+#include "kernel/cpu_caps.h"
 
 using nlohmann::json;
 

@@ -13,7 +13,7 @@
 #include <fstream>
 #include <string>
 
-#include "harness/common/errors.h"
+#include "kernel/errors.h"
 
 namespace fs = std::filesystem;
 

@@ -1,5 +1,5 @@
 // `iblcheck run --profile` (issue 33): where a run's time went, per stage and per test. Each test's
-// results object carries "profile" (seconds per stage, common/profile.h); this sums them over the
+// results object carries "profile" (seconds per stage, kernel/profile.h); this sums them over the
 // run, adds the run's own stages (the report, the files), and prints the table.
 #pragma once
 #include <map>

@@ -10,16 +10,16 @@
 #include <mutex>
 #include <thread>
 
-#include "harness/common/errors.h"
-#include "harness/common/output_files.h"
-#include "harness/common/profile.h"
+#include "kernel/errors.h"
+#include "kernel/output_files.h"
+#include "kernel/profile.h"
+#include "one_test.h"
 #include "provenance.h"
 #include "renderers/renderer.h"
 #include "reports/report_writer.h"
 #include "run_console.h"
 #include "run_files.h"
 #include "run_profile.h"
-#include "test_run.h"
 #include "verdict.h"
 #include "worker.h"
 
@@ -84,7 +84,7 @@ PoolOutcome run_tests(const std::vector<TestCase>& tests, const RunOptions& o, c
     return {std::move(results), std::move(driver), shader_error};
 }
 
-// The results document (reports/RESULTS_FORMAT.md): the run's facts, every test, the counts.
+// The results document (results/RESULTS_FORMAT.md): the run's facts, every test, the counts.
 void record_run(RunSummary& s, const std::string& suite, const RunOptions& o, PoolOutcome& pool, double total_s) {
     json& R = s.results;
     R = {{"schema", "iblcheck-results/1"}, {"suite", suite}, {"command", o.command_line}, {"started", utc_now_iso()}};

@@ -1,6 +1,6 @@
 // Runs a suite: render → metrics (image_compare.h) → verdict (verdict.h) → results JSON (+ JUnit,
 // report, images). The runner knows no Vulkan (it calls Renderer) and writes no goldens (bless.h
-// does). Here: the worker threads and the results document. One test's recipe is test_run.h; its
+// does). Here: the worker threads and the results document. One test's recipe is one_test.h; its
 // comparisons with the goldens golden_comparisons.h; its image files artefacts.h; stability and
 // temporal checks stability.h and temporal_check.h; the output folder's lock and the atomic JSON
 // run_files.h; what a run prints run_console.h.
@@ -13,7 +13,7 @@
 
 #include "bless.h"
 #include "golden_store.h"
-#include "junit.h"
+#include "results/junit.h"
 #include "suite.h"
 
 namespace iblcheck {

@@ -1,6 +1,6 @@
 #include "suite.h"
 
-#include "harness/common/name_filter.h"
+#include "kernel/name_filter.h"
 
 #include <fnmatch.h>
 
@@ -12,9 +12,9 @@
 #include <regex>
 #include <set>
 
-#include "harness/common/errors.h"
-#include "harness/common/json_check.h"
 #include "harness/golden_store.h"
+#include "kernel/errors.h"
+#include "kernel/json_check.h"
 #include "renderers/environments/environment.h"
 #include "renderers/option_table.h"
 #include "renderers/renderer.h"
@@ -31,7 +31,7 @@ const std::set<std::string> kMetrics = {"flip.mean",         "flip.p99",        
                                         "psnr.db",           "display_flip.mean", "display_flip.p99", "display_flip.block_max",
                                         "display_ssim.mean", "display_psnr.db"};
 
-// The suite reader's checks: the shared ones (harness/common/json_check.h) plus options and bounds.
+// The suite reader's checks: the shared ones (kernel/json_check.h) plus options and bounds.
 struct Ctx : JsonChecker {
     using JsonChecker::JsonChecker;
     // Option values are written as strings or numbers; both become the CLI's text form.

@@ -145,7 +145,7 @@ std::vector<std::string> suite_names();
 // `shader`: a team's shading file (`--shader FILE`) every mobile test runs, over the suite's own.
 Suite load_suite(const std::string& name_or_path, const std::string& shader = "");
 // Glob with * and ? (fnmatch semantics on the whole name); several globs separated by '|' match
-// a name when one of them does and no `!GLOB` among them does (harness/common/name_filter.h).
+// a name when one of them does and no `!GLOB` among them does (kernel/name_filter.h).
 bool glob_match(const std::string& pattern, const std::string& name);
 // Keeps the tests of shard `index` of `count` (round robin over the suite order).
 std::vector<TestCase> select_tests(const Suite& suite, const std::string& filter, int shard_index, int shard_count);

@@ -4,10 +4,10 @@
 
 #include <cmath>
 
-#include "harness/common/errors.h"
+#include "image_io/image_io.h"
+#include "kernel/errors.h"
 #include "metrics/display_transform.h"
 #include "metrics/flip.h"
-#include "metrics/image_io.h"
 #include "metrics/temporal.h"
 
 using nlohmann::json;

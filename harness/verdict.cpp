@@ -6,7 +6,7 @@
 #include <cmath>
 #include <limits>
 
-#include "harness/common/errors.h"
+#include "kernel/errors.h"
 
 using nlohmann::json;
 

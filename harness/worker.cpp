@@ -2,9 +2,9 @@
 
 #include <fmt/core.h>
 
-#include "harness/common/errors.h"
+#include "image_io/image_io.h"
+#include "kernel/errors.h"
 #include "metrics/display_transform.h"
-#include "metrics/image_io.h"
 
 namespace iblcheck {
 

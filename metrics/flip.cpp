@@ -24,7 +24,7 @@
 
 #include "metrics/identical.h"
 
-#include "harness/common/errors.h"
+#include "kernel/errors.h"
 #include "metrics/flip/color_spaces.h"
 #include "metrics/flip/csf_filters.h"
 #include "metrics/flip/feature_detection.h"

@@ -1,5 +1,5 @@
 // A FLIP result as JSON: the keys results.json's "flip" object and `iblcheck compare --json` share
-// (reports/RESULTS_FORMAT.md), written in one place so the two cannot drift apart.
+// (results/RESULTS_FORMAT.md), written in one place so the two cannot drift apart.
 #pragma once
 #include <nlohmann/json.hpp>
 

@@ -1,5 +1,5 @@
 // Magma rendering of a FLIP error map (metrics/flip.h).
-#include "harness/common/errors.h"
+#include "kernel/errors.h"
 #include "metrics/flip.h"
 #include "metrics/flip/magma_table.h"
 

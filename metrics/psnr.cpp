@@ -3,7 +3,7 @@
 #include <cmath>
 #include <limits>
 
-#include "harness/common/errors.h"
+#include "kernel/errors.h"
 #include "metrics/identical.h"
 
 namespace iblcheck {

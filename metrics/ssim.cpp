@@ -2,7 +2,7 @@
 
 #include <opencv2/imgproc.hpp>
 
-#include "harness/common/errors.h"
+#include "kernel/errors.h"
 #include "metrics/display_transform.h"
 #include "metrics/identical.h"
 

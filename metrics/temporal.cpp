@@ -4,7 +4,7 @@
 #include <limits>
 #include <string>
 
-#include "harness/common/errors.h"
+#include "kernel/errors.h"
 
 namespace iblcheck {
 

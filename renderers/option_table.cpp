@@ -4,7 +4,7 @@
 #include <cctype>
 #include <stdexcept>
 
-#include "harness/common/errors.h"
+#include "kernel/errors.h"
 
 namespace iblcheck {
 
@@ -83,7 +83,7 @@ const std::vector<OptionInfo>& option_catalog() {
         {"split_sum", "off", "off|exact|env_brdf_approx", "reference", "",
          "quadrature truth: off renders the truth; exact / env_brdf_approx the split sum's rungs of `iblcheck explain` "
          "(prefiltered radiance at n = v = R times the exact DFG or EnvBRDFApprox, plus the exact diffuse; the coarse level "
-         "only; renderers/reference/split_sum.h)"},
+         "only; renderers/reference/quadrature/split_sum.h)"},
     };
     return table;
 }

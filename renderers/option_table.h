@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "harness/common/options.h"
+#include "kernel/options.h"
 
 namespace iblcheck {
 

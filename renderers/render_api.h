@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "harness/common/options.h"
+#include "kernel/options.h"
 
 namespace iblcheck {
 

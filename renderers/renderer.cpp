@@ -3,9 +3,9 @@
 #include <chrono>
 #include <set>
 
-#include "harness/common/errors.h"
-#include "harness/common/hash.h"
-#include "harness/common/profile.h"
+#include "kernel/errors.h"
+#include "kernel/hash.h"
+#include "kernel/profile.h"
 #include "renderers/environments/environment.h"
 #include "renderers/mobile/gpu_session.h"
 #include "renderers/mobile/mobile_renderer.h"

@@ -8,8 +8,8 @@
 
 #include <fmt/format.h>
 
-#include "harness/common/name_filter.h"
-#include "harness/common/shell_quote.h"
+#include "kernel/name_filter.h"
+#include "kernel/shell_quote.h"
 #include "reports/report_html.h"
 
 using nlohmann::json;

@@ -34,7 +34,7 @@ std::vector<FailureGroup> group_failures(const std::vector<const nlohmann::json*
 // Whether `results` (its "command" and "shard") ran the whole suite.
 bool ran_whole_suite(const nlohmann::json& results);
 
-// A short `--filter` (harness/common/name_filter.h) found greedily that selects every name of
+// A short `--filter` (kernel/name_filter.h) found greedily that selects every name of
 // `members` and no other name of `all` (`all` holds the members too): the shorter of globs that
 // match only members, and one glob over every member with `!GLOB`s for the others it catches.
 // Globs replace name parts (method.scene.env.variant) with '*' or keep one option ('*KEY=VALUE*',

@@ -9,12 +9,12 @@
 #include <opencv2/imgproc.hpp>
 #include <zlib.h>
 
-#include "harness/common/errors.h"
-#include "harness/common/hash.h"
-#include "harness/common/output_files.h"
+#include "image_io/image_io.h"
+#include "kernel/errors.h"
+#include "kernel/hash.h"
+#include "kernel/output_files.h"
 #include "metrics/display_transform.h"
 #include "metrics/flip/tone_mappers.h"
-#include "metrics/image_io.h"
 
 namespace iblcheck::report {
 

@@ -1,4 +1,4 @@
-// The history file: JSON lines, one compact entry per run (reports/RESULTS_FORMAT.md, "History").
+// The history file: JSON lines, one compact entry per run (results/RESULTS_FORMAT.md, "History").
 #include <fcntl.h>
 #include <sys/file.h>
 #include <unistd.h>
@@ -11,8 +11,8 @@
 
 #include <fmt/format.h>
 
-#include "harness/common/errors.h"
-#include "harness/common/input_file.h"
+#include "kernel/errors.h"
+#include "kernel/input_file.h"
 #include "reports/report_writer.h"
 
 namespace iblcheck::report {

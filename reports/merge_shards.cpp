@@ -8,7 +8,7 @@
 #include <regex>
 #include <set>
 
-#include "harness/common/errors.h"
+#include "kernel/errors.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;

@@ -8,7 +8,7 @@
 
 #include <fmt/format.h>
 
-#include "harness/common/errors.h"
+#include "kernel/errors.h"
 #include "reports/report_html.h"
 #include "reports/report_writer.h"
 

@@ -6,8 +6,8 @@
 
 #include <fmt/format.h>
 
-#include "harness/common/errors.h"
-#include "harness/common/output_files.h"
+#include "kernel/errors.h"
+#include "kernel/output_files.h"
 
 namespace iblcheck::report::html {
 

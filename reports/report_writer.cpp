@@ -1,4 +1,4 @@
-// The static HTML report (issues 8, 17). See report_writer.h and reports/RESULTS_FORMAT.md.
+// The static HTML report (issues 8, 17). See report_writer.h and results/RESULTS_FORMAT.md.
 // Layout, top to bottom: the summary (counts, run facts, what changed since the baselines, the one
 // command that approves every failure); tabs: Tests (failures expanded, passing tests as a grid of
 // thumbnails that open their card), Charts (report_charts.cpp), History, and a table of all tests.
@@ -13,8 +13,8 @@
 
 #include <fmt/format.h>
 
-#include "harness/common/errors.h"
-#include "harness/common/shell_quote.h"
+#include "kernel/errors.h"
+#include "kernel/shell_quote.h"
 #include "metrics/flip/magma_table.h"
 #include "metrics/flip/tone_mappers.h"
 #include "reports/drift.h"

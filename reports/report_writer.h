@@ -5,7 +5,7 @@
 // pointer), the passing tests as a grid of thumbnails that open their card, and charts and history
 // on their own tabs. It opens from the file system (file://), offline: CSS, JS and SVG charts are
 // inline, every image it shows is copied next to it, and the float data is in data/*.js.
-// The input is the results JSON the harness writes (reports/RESULTS_FORMAT.md) and, optionally,
+// The input is the results JSON the harness writes (results/RESULTS_FORMAT.md) and, optionally,
 // the history file (JSON lines, one compact entry per run) for the trend sparklines.
 #pragma once
 #include <filesystem>
@@ -13,6 +13,8 @@
 #include <vector>
 
 #include <nlohmann/json.hpp>
+
+#include "results/results_file.h"
 
 namespace iblcheck::report {
 
@@ -27,11 +29,9 @@ namespace iblcheck::report {
 void write_report(const nlohmann::json& results, const std::filesystem::path& results_dir, const std::filesystem::path& out_dir,
                   const std::vector<nlohmann::json>& history = {}, const std::vector<nlohmann::json>& findings = {});
 
-// Reads and validates a results file (InputError naming the file: unreadable, not JSON, schema).
-nlohmann::json read_results(const std::filesystem::path& results_file);
-
-// Checks `results` against schema iblcheck-results/1; throws InputError "<source>: <where>: <problem>".
-void validate_results(const nlohmann::json& results, const std::string& source);
+// read_results, validate_results: results/results_file.h.
+using results::read_results;
+using results::validate_results;
 
 // History: JSON lines, one entry per run, oldest first. A missing file gives an empty history;
 // a malformed line throws InputError naming file and line.

@@ -1,5 +1,5 @@
 #include "reports/svg_chart.h"
-#include "harness/common/markup.h"
+#include "kernel/markup.h"
 
 #include <algorithm>
 #include <cmath>

@@ -2,18 +2,16 @@
 
 #include <fmt/core.h>
 
-#include "harness/common/shell_quote.h"
+#include "kernel/shell_quote.h"
 #include "reports/failure_groups.h"
+#include "reports/report_html.h"
 
 using nlohmann::json;
 
 namespace iblcheck::report {
 
 namespace {
-std::string str(const json& j, const char* k) {
-    auto it = j.find(k);
-    return it != j.end() && it->is_string() ? it->get<std::string>() : std::string();
-}
+using html::str;
 bool is_num(const json& j, const char* k) { return j.is_object() && j.contains(k) && j[k].is_number(); }
 
 // "accuracy vs truth: 0.2844 -> 0.2990 (+5.1 %), band [0.2276, 0.3146]" from the reference

@@ -3,7 +3,7 @@
 # One command:  scripts/regenerate_reference_goldens.sh   (env: BUILD_DIR=..., TEMPORAL=1 adds the temporal truth,
 # TEMPORAL=only writes the temporal truth alone)
 #
-# The truth is the deterministic quadrature (renderers/reference/truth_renderer.h; method and measurements in
+# The truth is the deterministic quadrature (renderers/reference/quadrature/truth_renderer.h; method and measurements in
 # renderers/reference/CONVERGENCE.md): each golden is the finer of two refinement levels, and its sidecar states
 # the error bound — the two levels' difference as relative RMSE and mean FLIP, per sphere and at the worst
 # pixel — and whether issue 5's criterion (mean FLIP < 0.002, relative RMSE < 0.5 %) is met

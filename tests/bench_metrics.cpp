@@ -31,9 +31,9 @@
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
+#include "image_io/image_io.h"
 #include "metrics/flip.h"
 #include "metrics/flip/kernels.h"
-#include "metrics/image_io.h"
 #include "metrics/ssim.h"
 
 extern char** environ;

@@ -3,8 +3,8 @@
 
 #include <fmt/format.h>
 
+#include "image_io/image_io.h"
 #include "metrics/display_transform.h"
-#include "metrics/image_io.h"
 #include "tests/report_fixture.h"
 #include "tests/report_fixture_images.h"
 

@@ -8,8 +8,8 @@
 
 #include <fmt/format.h>
 
+#include "image_io/image_io.h"
 #include "metrics/display_transform.h"
-#include "metrics/image_io.h"
 #include "reports/report_writer.h"
 #include "tests/report_fixture_images.h"
 

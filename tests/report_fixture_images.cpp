@@ -6,9 +6,9 @@
 
 #include <fmt/format.h>
 
+#include "image_io/image_io.h"
 #include "metrics/display_transform.h"
 #include "metrics/flip.h"
-#include "metrics/image_io.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;

@@ -8,7 +8,7 @@
 #include <cmath>
 #include <vector>
 
-#include "harness/common/errors.h"
+#include "kernel/errors.h"
 #include "renderers/mobile/astc_storage.h"
 #include "renderers/mobile/env_layout.h"
 #include "renderers/mobile/ibl_precompute.h"

@@ -10,7 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "metrics/image_io.h"
+#include "image_io/image_io.h"
 #include "tests/test_support.h"
 
 namespace fs = std::filesystem;

@@ -13,9 +13,9 @@
 #include <OpenImageIO/imageio.h>
 #include <nlohmann/json.hpp>
 
-#include "harness/cli/compare_command.h"
-#include "harness/common/errors.h"
-#include "metrics/image_io.h"
+#include "cli/compare_command.h"
+#include "image_io/image_io.h"
+#include "kernel/errors.h"
 #include "tests/synthetic_image.h"
 #include "tests/test_support.h"
 

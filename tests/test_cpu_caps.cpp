@@ -1,4 +1,4 @@
-// llvmpipe's CPU features (renderers/vulkan/cpu_caps.h): Mesa 22.3's override rules on fixed
+// llvmpipe's CPU features (kernel/cpu_caps.h): Mesa 22.3's override rules on fixed
 // /proc/cpuinfo flags, then the model against Mesa's own GALLIUM_DUMP_CPU output on this machine
 // for every override value (through `iblcheck doctor`, which also prints the model's cpu_class).
 #include <gtest/gtest.h>
@@ -10,7 +10,7 @@
 #include <sstream>
 #include <sys/wait.h>
 
-#include "renderers/vulkan/cpu_caps.h"
+#include "kernel/cpu_caps.h"
 #include "tests/test_support.h"
 
 using namespace iblcheck;

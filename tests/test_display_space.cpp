@@ -7,12 +7,12 @@
 #include <cmath>
 #include <filesystem>
 
-#include "harness/common/errors.h"
 #include "harness/golden_comparisons.h"
 #include "harness/golden_store.h"
 #include "harness/image_compare.h"
 #include "harness/suite.h"
 #include "harness/verdict.h"
+#include "kernel/errors.h"
 #include "metrics/display_space.h"
 #include "metrics/display_transform.h"
 #include "reports/report_html.h"

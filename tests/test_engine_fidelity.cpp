@@ -11,8 +11,8 @@
 #include <filesystem>
 
 #include "harness/furnace_figure.h"
+#include "image_io/image_io.h"
 #include "metrics/flip.h"
-#include "metrics/image_io.h"
 #include "renderers/environments/environment.h"
 #include "renderers/mobile/ibl_precompute.h"
 #include "renderers/mobile/mip_chain.h"

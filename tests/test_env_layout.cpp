@@ -8,7 +8,7 @@
 #include <cmath>
 #include <random>
 
-#include "harness/common/errors.h"
+#include "kernel/errors.h"
 #include "renderers/mobile/env_layout.h"
 #include "renderers/mobile/mip_chain.h"
 

@@ -6,10 +6,10 @@
 
 #include <cmath>
 
-#include "harness/common/errors.h"
+#include "kernel/errors.h"
 #include "renderers/environments/environment.h"
-#include "renderers/reference/split_sum.h"
-#include "renderers/reference/truth_renderer.h"
+#include "renderers/reference/quadrature/split_sum.h"
+#include "renderers/reference/quadrature/truth_renderer.h"
 #include "renderers/scenes/coverage.h"
 #include "renderers/scenes/scene.h"
 

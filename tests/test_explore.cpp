@@ -5,8 +5,8 @@
 #include <fstream>
 #include <map>
 
-#include "harness/common/errors.h"
 #include "harness/explore.h"
+#include "kernel/errors.h"
 #include "test_support.h"
 
 namespace iblcheck {

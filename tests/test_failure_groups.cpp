@@ -4,7 +4,7 @@
 
 #include <fmt/format.h>
 
-#include "harness/common/name_filter.h"
+#include "kernel/name_filter.h"
 #include "reports/failure_groups.h"
 #include "reports/verdict_text.h"
 

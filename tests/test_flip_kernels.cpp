@@ -12,7 +12,7 @@
 #include <random>
 #include <vector>
 
-#include "harness/common/errors.h"
+#include "kernel/errors.h"
 #include "metrics/flip.h"
 #include "metrics/flip/kernels.h"
 #include "metrics/flip/pooling.h"

@@ -8,8 +8,8 @@
 #include <cstring>
 #include <iostream>
 
+#include "image_io/image_io.h"
 #include "metrics/flip.h"
-#include "metrics/image_io.h"
 #include "metrics/psnr.h"
 #include "renderers/environments/environment.h"
 #include "renderers/mobile/fragment_shading.h"

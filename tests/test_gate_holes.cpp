@@ -15,10 +15,10 @@
 #include <fstream>
 #include <limits>
 
-#include "harness/common/errors.h"
 #include "harness/golden_store.h"
 #include "harness/runner.h"
-#include "metrics/image_io.h"
+#include "image_io/image_io.h"
+#include "kernel/errors.h"
 #include "tests/furnace_store.h"
 #include "tests/test_support.h"
 

@@ -9,7 +9,7 @@
 #include <fstream>
 #include <memory>
 
-#include "harness/common/errors.h"
+#include "kernel/errors.h"
 #include "renderers/vulkan/graphics_pipeline.h"
 #include "renderers/vulkan/spirv_cost.h"
 

@@ -14,12 +14,12 @@
 #include <set>
 #include <sys/wait.h>
 
-#include "harness/common/errors.h"
 #include "harness/golden_store.h"
 #include "harness/image_compare.h"
 #include "harness/run_console.h"
 #include "harness/runner.h"
 #include "harness/suite.h"
+#include "kernel/errors.h"
 #include "renderers/environments/environment.h"
 #include "tests/test_support.h"
 
@@ -32,7 +32,7 @@ namespace {
 using namespace iblcheck::testutil;
 
 std::string iblcheck_bin() { return std::string(IBLCHECK_BINARY_DIR) + "/iblcheck"; }
-// The binary as the commands it prints name it from this folder (harness/common/program.h): its relative
+// The binary as the commands it prints name it from this folder (kernel/program.h): its relative
 // path when shorter than the absolute one (it is not on PATH here).
 std::string printed_bin() {
     const std::string rel = fs::path(iblcheck_bin()).lexically_relative(fs::current_path()).string();

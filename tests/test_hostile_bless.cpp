@@ -11,10 +11,10 @@
 #include <fstream>
 
 #include "harness/bless.h"
-#include "harness/common/errors.h"
-#include "harness/common/shell_quote.h"
 #include "harness/golden_store.h"
 #include "harness/suite.h"
+#include "kernel/errors.h"
+#include "kernel/shell_quote.h"
 #include "reports/verdict_text.h"
 #include "tests/furnace_store.h"
 #include "tests/test_support.h"

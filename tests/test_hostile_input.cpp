@@ -15,10 +15,10 @@
 #include <regex>
 #include <string>
 
-#include "harness/common/errors.h"
 #include "harness/golden_store.h"
 #include "harness/suite.h"
-#include "metrics/image_io.h"
+#include "image_io/image_io.h"
+#include "kernel/errors.h"
 #include "renderers/environments/environment.h"
 #include "reports/report_writer.h"
 #include "tests/test_support.h"

@@ -10,10 +10,10 @@
 #include <fstream>
 
 #include "harness/bless.h"
-#include "harness/common/errors.h"
 #include "harness/golden_store.h"
+#include "harness/one_test.h"
 #include "harness/suite.h"
-#include "harness/test_run.h"
+#include "kernel/errors.h"
 #include "reports/report_writer.h"
 #include "tests/furnace_store.h"
 #include "tests/test_support.h"

@@ -1,4 +1,4 @@
-// The image file codecs (metrics/image_formats.h): OpenEXR and PNG are read without OpenImageIO,
+// The image file codecs (image_io/image_formats.h): OpenEXR and PNG are read without OpenImageIO,
 // and must return exactly what OpenImageIO returns (the plugin, libiblcheck_oiio.so, is the
 // oracle) on files written by OpenImageIO itself in every layout the harness may meet; other
 // formats go through the plugin; reading EXR/PNG never loads it.
@@ -12,9 +12,9 @@
 #include <fstream>
 #include <random>
 
-#include "harness/common/errors.h"
-#include "metrics/image_formats.h"
-#include "metrics/image_io.h"
+#include "image_io/image_formats.h"
+#include "image_io/image_io.h"
+#include "kernel/errors.h"
 #include "tests/test_support.h"
 
 namespace fs = std::filesystem;

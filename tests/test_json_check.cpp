@@ -1,9 +1,9 @@
-// The shared JSON checker (harness/common/json_check.h): every error names the file, where in it,
+// The shared JSON checker (kernel/json_check.h): every error names the file, where in it,
 // and the problem with the type actually found.
 #include <gtest/gtest.h>
 
-#include "harness/common/errors.h"
-#include "harness/common/json_check.h"
+#include "kernel/errors.h"
+#include "kernel/json_check.h"
 
 using namespace iblcheck;
 using nlohmann::json;

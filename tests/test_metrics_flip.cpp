@@ -12,13 +12,13 @@
 
 #include <nlohmann/json.hpp>
 
-#include "harness/common/errors.h"
+#include "image_io/image_io.h"
+#include "kernel/errors.h"
 #include "metrics/display_transform.h"
 #include "metrics/flip.h"
 #include "metrics/flip/kernels.h"
 #include "metrics/flip/magma_table.h"
 #include "metrics/flip_json.h"
-#include "metrics/image_io.h"
 #include "tests/synthetic_image.h"
 
 namespace fs = std::filesystem;

@@ -11,9 +11,9 @@
 #include <OpenImageIO/imageio.h>
 #include <nlohmann/json.hpp>
 
-#include "harness/common/errors.h"
+#include "image_io/image_io.h"
+#include "kernel/errors.h"
 #include "metrics/display_transform.h"
-#include "metrics/image_io.h"
 #include "metrics/psnr.h"
 #include "metrics/ssim.h"
 #include "metrics/temporal.h"

@@ -11,8 +11,8 @@
 #include <filesystem>
 #include <fstream>
 
+#include "image_io/image_io.h"
 #include "metrics/flip.h"
-#include "metrics/image_io.h"
 #include "renderers/environments/environment.h"
 #include "renderers/mobile/gpu_session.h"
 #include "renderers/mobile/mobile_renderer.h"

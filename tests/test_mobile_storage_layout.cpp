@@ -9,8 +9,8 @@
 #include <cmath>
 #include <cstring>
 
+#include "image_io/image_io.h"
 #include "metrics/flip.h"
-#include "metrics/image_io.h"
 #include "renderers/environments/environment.h"
 #include "renderers/mobile/astc_storage.h"
 #include "renderers/mobile/env_layout.h"

@@ -4,7 +4,7 @@
 
 #include <regex>
 
-#include "harness/common/errors.h"
+#include "kernel/errors.h"
 #include "report_fixture.h"
 #include "reports/nightly_findings.h"
 #include "reports/report_html.h"

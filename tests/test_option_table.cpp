@@ -8,7 +8,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "harness/common/errors.h"
+#include "kernel/errors.h"
 #include "renderers/option_table.h"
 #include "renderers/renderer.h"
 #include "renderers/vulkan/shader_compiler.h"

@@ -13,8 +13,8 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 
-#include "harness/common/shell_quote.h"
-#include "metrics/image_io.h"
+#include "image_io/image_io.h"
+#include "kernel/shell_quote.h"
 #include "tests/test_support.h"
 
 namespace fs = std::filesystem;

@@ -1,4 +1,4 @@
-// The Monte Carlo integrator's environment sampling (renderers/reference/env_distribution.h, mc_window.h):
+// The Monte Carlo integrator's environment sampling (renderers/reference/monte_carlo/env_distribution.h, mc_window.h):
 // the piecewise-constant distribution's pdf against its samples and the solid angle, its coarse cells, and
 // the windowed strategy against the global one (unbiased, less noisy) through whole renders.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// The Monte Carlo reference integrator (renderers/reference/monte_carlo.h) end to end: checked against
+// The Monte Carlo reference integrator (renderers/reference/monte_carlo/monte_carlo.h) end to end: checked against
 // values computed here by an independent deterministic quadrature of material_model.h, and against closed
 // forms; determinism, provenance, noise floor, the sub-pixel pattern. Its environment sampling is tested in
 // test_reference_env_sampling.cpp, its pieces beside them (renderers/reference/mc_*_test.cpp).

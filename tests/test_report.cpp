@@ -10,7 +10,7 @@
 #include <set>
 #include <sstream>
 
-#include "harness/common/name_filter.h"
+#include "kernel/name_filter.h"
 #include "reports/float_data.h"
 #include "reports/report_writer.h"
 #include "reports/svg_chart.h"

@@ -11,8 +11,8 @@
 #include <cmath>
 #include <fstream>
 
-#include "harness/cli/report_command.h"
-#include "harness/common/errors.h"
+#include "cli/report_command.h"
+#include "kernel/errors.h"
 #include "reports/drift.h"
 #include "reports/float_data.h"
 #include "reports/report_writer.h"

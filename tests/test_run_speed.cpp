@@ -14,11 +14,11 @@
 #include <set>
 #include <string>
 
-#include "harness/common/hash.h"
-#include "harness/common/profile.h"
-#include "harness/common/program.h"
 #include "harness/runner.h"
 #include "harness/suite.h"
+#include "kernel/hash.h"
+#include "kernel/profile.h"
+#include "kernel/program.h"
 #include "renderers/environments/environment.h"
 #include "renderers/mobile/cost_store.h"
 #include "renderers/mobile/precompute_store.h"

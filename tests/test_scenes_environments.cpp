@@ -6,8 +6,8 @@
 #include <filesystem>
 #include <limits>
 
-#include "harness/common/errors.h"
-#include "harness/common/options.h"
+#include "kernel/errors.h"
+#include "kernel/options.h"
 #include "renderers/environments/environment.h"
 #include "renderers/environments/procedural.h"
 #include "renderers/scenes/coverage.h"

@@ -12,8 +12,8 @@
 #include <nlohmann/json.hpp>
 
 #include "harness/bless.h"
-#include "harness/common/errors.h"
 #include "harness/suite.h"
+#include "kernel/errors.h"
 #include "renderers/vulkan/shader_compiler.h"
 #include "renderers/vulkan/spirv_samples.h"
 #include "tests/test_support.h"

@@ -8,12 +8,12 @@
 #include <functional>
 
 #include "harness/bless.h"
-#include "harness/common/errors.h"
 #include "harness/golden_store.h"
 #include "harness/image_compare.h"
 #include "harness/runner.h"
 #include "harness/suite.h"
-#include "metrics/image_io.h"
+#include "image_io/image_io.h"
+#include "kernel/errors.h"
 #include "tests/furnace_store.h"
 #include "tests/test_support.h"
 

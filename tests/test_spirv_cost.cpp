@@ -11,7 +11,7 @@
 #include <numeric>
 #include <sstream>
 
-#include "harness/common/errors.h"
+#include "kernel/errors.h"
 #include "renderers/vulkan/context.h"
 #include "renderers/vulkan/spirv_cost.h"
 

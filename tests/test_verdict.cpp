@@ -6,8 +6,8 @@
 #include <cmath>
 #include <limits>
 
-#include "harness/common/errors.h"
 #include "harness/verdict.h"
+#include "kernel/errors.h"
 
 using namespace iblcheck;
 using nlohmann::json;

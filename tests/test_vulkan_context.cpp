@@ -11,7 +11,7 @@
 #include <fstream>
 #include <sys/wait.h>
 
-#include "harness/common/errors.h"
+#include "kernel/errors.h"
 #include "renderers/option_table.h"
 #include "renderers/vulkan/context.h"
 #include "renderers/vulkan/fp16_emulation.h"

@@ -1,7 +1,7 @@
 // Which FLIP kernel variant runs (flip/kernels.h).
 #include <cstdlib>
 
-#include "harness/common/errors.h"
+#include "kernel/errors.h"
 #include "metrics/flip/kernels.h"
 
 namespace iblcheck::flip {

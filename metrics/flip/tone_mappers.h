@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "harness/common/errors.h"
+#include "kernel/errors.h"
 #include "metrics/flip/fast_math.h"
 #include "metrics/flip/flip_constants.h"
 

@@ -10,9 +10,9 @@
 
 #include <fmt/core.h>
 
-#include "harness/common/errors.h"
-#include "harness/common/options.h"
-#include "metrics/image_formats.h"
+#include "image_io/image_formats.h"
+#include "kernel/errors.h"
+#include "kernel/options.h"
 #include "renderers/environments/procedural.h"
 
 namespace iblcheck {

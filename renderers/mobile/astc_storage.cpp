@@ -8,7 +8,7 @@
 #include <cstring>
 #include <mutex>
 
-#include "harness/common/errors.h"
+#include "kernel/errors.h"
 
 namespace iblcheck {
 

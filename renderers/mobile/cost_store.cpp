@@ -3,9 +3,9 @@
 #include <cstring>
 #include <fstream>
 
-#include "harness/common/hash.h"
+#include "kernel/cpu_caps.h"
+#include "kernel/hash.h"
 #include "precompute_store.h"
-#include "renderers/vulkan/cpu_caps.h"
 #include "renderers/vulkan/shader_compiler.h"
 
 namespace fs = std::filesystem;

@@ -15,8 +15,8 @@
 #include <vector>
 
 #include "gpu_session.h"
-#include "harness/common/program.h"
 #include "ibl_precompute.h"
+#include "kernel/program.h"
 
 namespace iblcheck {
 

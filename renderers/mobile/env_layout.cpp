@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "harness/common/errors.h"
+#include "kernel/errors.h"
 
 namespace iblcheck {
 

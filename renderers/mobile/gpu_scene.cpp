@@ -5,7 +5,7 @@
 
 #include <fmt/format.h>
 
-#include "harness/common/errors.h"
+#include "kernel/errors.h"
 
 namespace iblcheck {
 

@@ -1,6 +1,6 @@
 #include "gpu_session.h"
 
-#include "harness/common/profile.h"
+#include "kernel/profile.h"
 
 namespace iblcheck {
 

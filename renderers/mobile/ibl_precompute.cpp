@@ -7,8 +7,8 @@
 
 #include "astc_storage.h"
 #include "env_layout.h"
-#include "harness/common/errors.h"
-#include "harness/common/profile.h"
+#include "kernel/errors.h"
+#include "kernel/profile.h"
 #include "mip_chain.h"
 #include "precompute_store.h"
 #include "renderers/mobile/descriptor_types.h"

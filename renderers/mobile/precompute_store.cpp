@@ -6,9 +6,9 @@
 #include <fstream>
 #include <thread>
 
-#include "harness/common/hash.h"
-#include "harness/common/profile.h"
-#include "renderers/vulkan/cpu_caps.h"
+#include "kernel/cpu_caps.h"
+#include "kernel/hash.h"
+#include "kernel/profile.h"
 #include "renderers/vulkan/shader_compiler.h"
 
 namespace fs = std::filesystem;

@@ -13,8 +13,8 @@
 #include <string_view>
 #include <vector>
 
-#include "harness/common/program.h"
 #include "ibl_precompute.h"
+#include "kernel/program.h"
 
 namespace iblcheck {
 

@@ -3,8 +3,8 @@
 #include <cstring>
 
 #include "cost_store.h"
-#include "harness/common/errors.h"
-#include "harness/common/profile.h"
+#include "kernel/errors.h"
+#include "kernel/profile.h"
 #include "renderers/vulkan/spirv_cost.h"
 
 namespace iblcheck {

@@ -19,8 +19,8 @@
 //     relative tolerance, default 1e-3), integrator; the Monte Carlo integrator's own (monte_carlo.h).
 // Method, measurements and their derivations: renderers/reference/CONVERGENCE.md.
 #pragma once
-#include "renderers/reference/monte_carlo.h"
-#include "renderers/reference/truth_renderer.h"
+#include "renderers/reference/monte_carlo/monte_carlo.h"
+#include "renderers/reference/quadrature/truth_renderer.h"
 
 namespace iblcheck {
 

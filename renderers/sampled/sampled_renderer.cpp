@@ -2,8 +2,8 @@
 // pyramid and SH9 passes with the mobile pipeline and skips the prefiltered chain.
 #include "sampled_renderer.h"
 
-#include "harness/common/errors.h"
-#include "harness/common/profile.h"
+#include "kernel/errors.h"
+#include "kernel/profile.h"
 #include "renderers/mobile/cost_store.h"
 #include "renderers/mobile/gpu_scene.h"
 #include "renderers/mobile/ibl_precompute.h"

@@ -13,8 +13,8 @@
 #include <string>
 #include <vector>
 
-#include "harness/common/options.h"
-#include "harness/common/vec3.h"
+#include "kernel/options.h"
+#include "kernel/vec3.h"
 
 namespace iblcheck {
 

@@ -1,7 +1,7 @@
 // Compute pipelines with push descriptors and push constants, and what the compute and graphics
 // pipelines share: their layouts (pipeline_layout.h) and the descriptor writes (Context::push_descriptors).
 #include "context.h"
-#include "harness/common/errors.h"
+#include "kernel/errors.h"
 #include "pipeline_layout.h"
 #include "spirv_cost.h"
 #include "vk_struct.h"

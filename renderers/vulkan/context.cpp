@@ -3,7 +3,7 @@
 #include <cstring>
 #include <regex>
 
-#include "harness/common/errors.h"
+#include "kernel/errors.h"
 #include "vk_struct.h"
 
 namespace iblcheck::vk {

@@ -62,7 +62,7 @@
 #include <unordered_map>
 
 #include "fp16_module.h"
-#include "harness/common/errors.h"
+#include "kernel/errors.h"
 
 namespace iblcheck::vk {
 

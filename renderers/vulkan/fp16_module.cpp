@@ -7,7 +7,7 @@
 #include <cstring>
 #include <string>
 
-#include "harness/common/errors.h"
+#include "kernel/errors.h"
 
 namespace iblcheck::vk::fp16 {
 

@@ -1,6 +1,6 @@
 // Timestamp queries around passes (GpuTimer, context.h).
 #include "context.h"
-#include "harness/common/errors.h"
+#include "kernel/errors.h"
 #include "vk_struct.h"
 
 namespace iblcheck::vk {

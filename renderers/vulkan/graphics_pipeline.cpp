@@ -2,7 +2,7 @@
 
 #include <string>
 
-#include "harness/common/errors.h"
+#include "kernel/errors.h"
 #include "pipeline_layout.h"
 #include "spirv_cost.h"
 #include "vk_struct.h"

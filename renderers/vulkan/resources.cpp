@@ -4,7 +4,7 @@
 
 #include "context.h"
 #include "half_float.h"
-#include "harness/common/errors.h"
+#include "kernel/errors.h"
 #include "vk_struct.h"
 
 namespace iblcheck::vk {

@@ -15,9 +15,9 @@
 
 #include "fp16_emulation.h"
 #include "fp16_pass_hash.h" // generated: IBLCHECK_FP16_PASS_HASH
-#include "harness/common/errors.h"
-#include "harness/common/hash.h"
-#include "harness/common/profile.h"
+#include "kernel/errors.h"
+#include "kernel/hash.h"
+#include "kernel/profile.h"
 #include "spirv_cost.h"
 
 namespace fs = std::filesystem;

@@ -7,7 +7,7 @@
 #include <set>
 #include <string>
 
-#include "harness/common/errors.h"
+#include "kernel/errors.h"
 
 namespace iblcheck::vk {
 

@@ -3,7 +3,7 @@
 #include <map>
 #include <set>
 
-#include "harness/common/errors.h"
+#include "kernel/errors.h"
 
 namespace iblcheck::vk {
 

@@ -1,0 +1,74 @@
+// One pixel of the Monte Carlo integrator (mc_pixel.h): the sphere culling is conservative and the
+// candidate intersection is scene.cpp's; a pixel's coverage is the fraction of its positions that hit.
+#include "renderers/reference/monte_carlo/mc_pixel.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+using namespace iblcheck;
+using namespace iblcheck::reference;
+
+// Every sub-pixel ray of the roughness sweep (4x4 per pixel) that hits a sphere hits one of the pixel's
+// candidates, and intersect_candidates finds the same sphere and normal as intersect().
+TEST(McPixel, CandidatesAreConservativeAndIntersectAsTheScene) {
+    const Scene scene = build_scene("roughness_sweep", OptionMap{});
+    const int W = scene.width, H = scene.height;
+    std::vector<int> cand;
+    long hits = 0;
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            pixel_candidates(scene, W, H, x, y, cand);
+            for (int k = 0; k < 16; ++k) {
+                Vec3f o, d;
+                camera_ray(scene, W, H, x + (k % 4 + 0.5) / 4, y + (k / 4 + 0.5) / 4, o, d);
+                const Hit h = intersect(scene, o, d);
+                int sphere;
+                Vec3d n;
+                const bool hit = intersect_candidates(scene, cand, o, d, sphere, n);
+                ASSERT_EQ(hit, h.hit) << x << "," << y;
+                if (!h.hit) continue;
+                ++hits;
+                ASSERT_NE(std::find(cand.begin(), cand.end(), h.sphere), cand.end()) << x << "," << y;
+                EXPECT_EQ(sphere, h.sphere);
+                EXPECT_NEAR(n.x, h.normal.x, 1e-6);
+                EXPECT_NEAR(n.y, h.normal.y, 1e-6);
+                EXPECT_NEAR(n.z, h.normal.z, 1e-6);
+            }
+        }
+    EXPECT_GT(hits, 0);
+}
+
+TEST(McPixel, CoverageIsTheFractionOfPositionsThatHit) {
+    const Scene scene = build_scene("sphere", OptionMap{});
+    const int W = scene.width, H = scene.height;
+    const Environment env = load_environment("constant:1");
+    const EnvDistribution dist(env);
+    cv::Mat equirect = env.equirect.clone();
+    const EnvImage img(equirect);
+    const Shader shader{img, dist, McLobes::all, true, true};
+    const std::vector<MatConst> mats = {mat_const(scene.spheres[0].material, McLobes::all)};
+    const PixelContext ctx{scene, W, H, shader, mats, false};
+    std::vector<int> cand;
+    long fetches = 0;
+    pixel_candidates(scene, W, H, W / 2, H / 2, cand);
+    const PixelOut inside = render_pixel(ctx, W / 2, H / 2, 16, 2, 1, 2, cand, fetches);
+    EXPECT_EQ(inside.coverage, 1.0);
+    EXPECT_GT(inside.rgb[0], 0);
+    EXPECT_GE(inside.lum_var, 0);
+    EXPECT_GT(fetches, 0);
+    pixel_candidates(scene, W, H, 0, 0, cand);
+    const PixelOut corner = render_pixel(ctx, 0, 0, 16, 2, 1, 2, cand, fetches);
+    EXPECT_EQ(corner.coverage, 0.0);
+    EXPECT_EQ(corner.rgb[0], 0.0);
+    // A silhouette pixel: some positions hit. Find one along the centre row.
+    for (int x = 0; x < W / 2; ++x) {
+        pixel_candidates(scene, W, H, x, H / 2, cand);
+        const PixelOut p = render_pixel(ctx, x, H / 2, 64, 1, 1, 2, cand, fetches);
+        if (p.coverage == 0) continue;
+        EXPECT_LT(p.coverage, 1.0) << "the first pixel that hits is on the silhouette";
+        EXPECT_EQ(std::fmod(p.coverage * 64, 1.0), 0.0);
+        break;
+    }
+}

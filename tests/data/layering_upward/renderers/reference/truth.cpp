@@ -1,0 +1,2 @@
+#include "metrics/flip.h"
+#include "renderers/vulkan/context.h"
