@@ -7,6 +7,7 @@
 #include <chrono>
 #include <filesystem>
 
+#include "harness/golden_store.h"
 #include "harness/truth/truth_golden.h"
 #include "metrics/flip.h"
 
@@ -59,10 +60,10 @@ MonteCarloGoldenWritten write_monte_carlo_golden(const MonteCarloGoldenRequest& 
     meta["spp"] = req.spp;
     meta["time_s"] = time_s;
     meta["command"] = req.command;
-    meta["date"] = utc_now();
+    meta["date"] = utc_now_iso();
     meta["image"] = std::filesystem::path(req.out_exr).filename().string(); // beside the sidecar: no machine path
     meta["channels"] = "R,G,B float32 linear";
-    write_golden_files(req.out_exr, nf.image_a, meta);
+    GoldenStore::write_golden(req.out_exr, nf.image_a, meta);
     return out;
 }
 
