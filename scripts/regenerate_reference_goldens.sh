@@ -49,30 +49,25 @@ name_of() { # scene env [truth options...]: the golden store's name, asked of th
   shift 2
   "$TOOL" truth --print-name --scene "$scene" --env "$env" "$@"
 }
-truth() { # scene env [key=value...]: the quadrature truth
-  local scene=$1 env=$2 name t0
-  shift 2
+still() { # "note" scene env [truth options...] -- [key=value...]: one still golden, named by the binary
+  local note=$1 scene=$2 env=$3 name t0 opts=()
+  shift 3
+  while [[ $1 != -- ]]; do opts+=("$1"); shift; done
+  shift
   mapfile -t sets < <(sets_of "$@")
   name=$(name_of "$scene" "$env" "${sets[@]}")
   if [[ "$LIST" == 1 ]]; then echo "$name"; return 0; fi
   t0=$(date +%s)
   mapfile -t cmp < <(compare_old "$name")
-  "$TOOL" truth --scene "$scene" --env "$env" "${sets[@]}" --out "$OUT/$name.exr" --force "${cmp[@]}" \
-    --command "scripts/regenerate_reference_goldens.sh" || [[ $? == 1 ]] # 1: written, criterion not met
+  "$TOOL" truth "${opts[@]}" --scene "$scene" --env "$env" "${sets[@]}" --out "$OUT/$name.exr" --force "${cmp[@]}" \
+    --command "scripts/regenerate_reference_goldens.sh$note" || [[ $? == 1 ]] # 1: written, criterion not met
   echo "[goldens] $name: $(( $(date +%s) - t0 )) s"
 }
+truth() { # scene env [key=value...]: the quadrature truth
+  still "" "$1" "$2" -- "${@:3}"
+}
 monte_carlo() { # scene env spp [key=value...]: the Monte Carlo integrator (seeds 0 and 1 for the noise floor)
-  local scene=$1 env=$2 spp=$3 name t0
-  shift 3
-  mapfile -t sets < <(sets_of "$@")
-  name=$(name_of "$scene" "$env" "${sets[@]}")
-  if [[ "$LIST" == 1 ]]; then echo "$name"; return 0; fi
-  t0=$(date +%s)
-  mapfile -t cmp < <(compare_old "$name")
-  "$TOOL" truth --integrator monte_carlo --scene "$scene" --env "$env" --spp "$spp" --seed 0 "${sets[@]}" \
-    --out "$OUT/$name.exr" --force "${cmp[@]}" --command "scripts/regenerate_reference_goldens.sh (spp=$spp)" \
-    || [[ $? == 1 ]] # 1: written, criterion not met
-  echo "[goldens] $name: $(( $(date +%s) - t0 )) s"
+  still " (spp=$3)" "$1" "$2" --integrator monte_carlo --spp "$3" --seed 0 -- "${@:4}"
 }
 sequence() { # scene env frames: the temporal truth, its frames stacked in one golden
   local scene=$1 env=$2 frames=$3 name t0
