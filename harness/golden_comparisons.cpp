@@ -6,10 +6,12 @@
 #include <cstring>
 
 #include "bless.h"
-#include "image_compare.h"
 #include "kernel/errors.h"
 #include "kernel/profile.h"
+#include "metrics/catalog.h"
+#include "metrics/image_compare.h"
 #include "provenance.h"
+#include "sphere_errors.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -142,15 +144,13 @@ Comparison judge_against_truth(const TestCase& tc, const RenderResult& rr, const
     Comparison c = judge_reference(metrics, approved_accuracy, tc.reference_band);
     c.golden = store.relative(ref.image_path);
     note_worst_block(c, rr.coverage, shown, tc.display.has_value());
-    r["accuracy"] = {{"flip_mean", flip.mean},
-                     {"ssim", metrics["ssim"]["mean"]},
-                     {"golden", c.golden},
-                     {"noise_floor", ref.provenance.value("noise_floor", json())}};
+    r["accuracy"] = {{"golden", c.golden}, {"noise_floor", ref.provenance.value("noise_floor", json())}};
     if (tc.display) // the truth as a player sees it: LDR-FLIP, SSIM and PSNR of both after the display
-        r["accuracy"]["display"] = {{"space", metrics["display"]},
-                                    {"flip_mean", metrics["display_flip"]["mean"]},
-                                    {"ssim", metrics["display_ssim"]["mean"]},
-                                    {"psnr_db", metrics["display_psnr"]["db"]}};
+        r["accuracy"]["display"] = {{"space", metrics["display"]}};
+    for (const MetricInfo* k : judged_metrics(tc.display.has_value())) // the summary's figures, by its names
+        if (*k->accuracy_name)
+            (k->space == MetricSpace::test_display ? r["accuracy"]["display"] : r["accuracy"])[k->accuracy_name] =
+                metrics[k->group][k->field];
     if (json ps = per_sphere_errors(rr.coverage, flip.errmap); !ps.is_null()) r["per_sphere"] = ps;
     if (art) {
         c.images = Artefacts::images(art.rel + "test.png", art.png("reference.png", ref.image, false),

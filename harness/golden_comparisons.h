@@ -1,4 +1,4 @@
-// A render against its goldens, each comparison measured (image_compare.h) and judged (verdict.h):
+// A render against its goldens, each comparison measured (metrics/image_compare.h) and judged (verdict.h):
 // the approved baselines (any one may pass the test), the cost recorded with the chosen baseline,
 // and the truth (the reference golden). Each comparison carries its report images when the test
 // writes artefacts, and the worst 16x16 block with the sphere it lies on (the render's coverage).

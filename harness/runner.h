@@ -1,4 +1,4 @@
-// Runs a suite: render → metrics (image_compare.h) → verdict (verdict.h) → results JSON (+ JUnit,
+// Runs a suite: render → metrics (metrics/image_compare.h) → verdict (verdict.h) → results JSON (+ JUnit,
 // report, images). The runner knows no Vulkan (it calls Renderer) and writes no goldens (bless.h
 // does). Here: the worker threads and the results document. One test's recipe is one_test.h; its
 // comparisons with the goldens golden_comparisons.h; its image files artefacts.h; stability and

@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "kernel/errors.h"
+#include "metrics/catalog.h"
 
 using nlohmann::json;
 
@@ -46,9 +47,9 @@ Verdict parse_verdict(std::string_view name) {
 bool is_regression(Verdict v) { return v == Verdict::fail || v == Verdict::missing_golden; }
 
 bool higher_is_better(std::string_view metric) {
-    if (metric.rfind("accuracy.", 0) == 0) metric.remove_prefix(9);
-    if (metric.rfind("display_", 0) == 0) metric.remove_prefix(8); // the same figures in display space
-    return metric.rfind("ssim", 0) == 0 || metric.rfind("psnr", 0) == 0;
+    if (metric.rfind("accuracy.", 0) == 0) metric.remove_prefix(9); // the same figure against the truth
+    const MetricInfo* m = find_metric(metric);                      // costs, temporal: lower is better
+    return m && m->direction == Direction::higher_is_better;
 }
 
 Check judge_bound(const std::string& metric, double value, const Bound& bound) {

@@ -43,7 +43,8 @@ struct Check {
     std::string message;            // empty on pass
 };
 
-// Larger is better for SSIM and PSNR; smaller for FLIP and costs.
+// As the metric catalog says (metrics/catalog.h, "accuracy." stripped): larger is better for SSIM
+// and PSNR; smaller for FLIP, and for what it does not list (costs, temporal figures).
 bool higher_is_better(std::string_view metric);
 
 // value within [min, max] passes; outside fails.

@@ -9,12 +9,12 @@
 
 #include "harness/golden_comparisons.h"
 #include "harness/golden_store.h"
-#include "harness/image_compare.h"
 #include "harness/suite.h"
 #include "harness/verdict.h"
 #include "kernel/errors.h"
 #include "metrics/display_space.h"
 #include "metrics/display_transform.h"
+#include "metrics/image_compare.h"
 #include "reports/report_html.h"
 #include "tests/test_support.h"
 
