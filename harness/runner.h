@@ -14,6 +14,7 @@
 #include "bless.h"
 #include "golden_store.h"
 #include "results/junit.h"
+#include "results/results.h"
 #include "suite.h"
 
 namespace iblcheck {
@@ -40,6 +41,7 @@ struct RunOptions {
     bool profile = false; // print where the time went (run_profile.h); each test's results gain "profile"
 };
 
+// The run's results (results/results.h, as JSON) and how many tests got each verdict.
 struct RunSummary {
     nlohmann::json results;
     int pass = 0, fail = 0, improved = 0, missing = 0, error = 0;

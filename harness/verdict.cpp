@@ -23,25 +23,7 @@ std::string percent_change(double value, double approved) {
     return fmt::format("{:+.1f} %", 100.0 * (value - approved) / approved);
 }
 
-json optional_json(const std::optional<double>& v) { return v ? json(*v) : json(); }
 } // namespace
-
-std::string_view verdict_name(Verdict v) {
-    switch (v) {
-    case Verdict::pass: return "pass";
-    case Verdict::improved: return "improved";
-    case Verdict::fail: return "fail";
-    case Verdict::missing_golden: return "missing-golden";
-    case Verdict::error: return "error";
-    }
-    return "error";
-}
-
-Verdict parse_verdict(std::string_view name) {
-    for (Verdict v : {Verdict::pass, Verdict::improved, Verdict::fail, Verdict::missing_golden, Verdict::error})
-        if (verdict_name(v) == name) return v;
-    throw InputError(fmt::format("unknown verdict '{}'", name));
-}
 
 bool is_regression(Verdict v) { return v == Verdict::fail || v == Verdict::missing_golden; }
 
@@ -180,29 +162,6 @@ size_t choose_baseline(const std::vector<Comparison>& candidates) {
         if (!std::isnan(f) && f < best_flip) best_flip = f, best = i;
     }
     return best;
-}
-
-json to_json(const Check& c) {
-    json j = {{"metric", c.metric},
-              {"value", std::isfinite(c.value) ? json(c.value) : json()},
-              {"min", optional_json(c.min)},
-              {"max", optional_json(c.max)},
-              {"status", verdict_name(c.status)}};
-    if (c.approved) j["approved"] = std::isfinite(*c.approved) ? json(*c.approved) : json();
-    if (!c.message.empty()) j["message"] = c.message;
-    return j;
-}
-
-json to_json(const Comparison& c) {
-    json j = {{"kind", c.kind}, {"golden", c.golden}, {"verdict", verdict_name(c.verdict)}};
-    if (c.kind == "baseline") j["label"] = c.label;
-    if (!c.metrics.is_null()) j["metrics"] = c.metrics;
-    j["checks"] = json::array();
-    for (const Check& k : c.checks) j["checks"].push_back(to_json(k));
-    if (!c.message.empty()) j["message"] = c.message;
-    if (!c.images.is_null()) j["images"] = c.images;
-    if (!c.worst_block.is_null()) j["worst_block"] = c.worst_block;
-    return j;
 }
 
 } // namespace iblcheck

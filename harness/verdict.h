@@ -1,6 +1,7 @@
 // Verdicts: what a test's numbers mean, decided in one place. The runner measures (render,
 // metrics, cost) and hands the numbers here; nothing here renders or reads files, so every rule is
-// unit-tested on plain numbers (tests/test_verdict.cpp).
+// unit-tested on plain numbers (tests/test_verdict.cpp). The results they fill (Check, Comparison,
+// Verdict) are the typed results of results/results.h.
 //
 // One function per kind of comparison, one signature (metric, measured value, criterion) -> Check,
 // after VK-GL-CTS's tcuImageCompare: a typed status and a message that says where, why and by how
@@ -15,13 +16,10 @@
 
 #include <nlohmann/json.hpp>
 
+#include "results/results.h"
+
 namespace iblcheck {
 
-// Ordered by severity: overall_verdict() keeps the worst.
-enum class Verdict { pass, improved, fail, missing_golden, error };
-
-std::string_view verdict_name(Verdict v);     // "pass", "improved", "fail", "missing-golden", "error"
-Verdict parse_verdict(std::string_view name); // throws InputError on an unknown name
 // A regression for CI and bisect: fail or missing-golden (exit 1). error is "cannot test" (exit 2).
 bool is_regression(Verdict v);
 
@@ -32,15 +30,6 @@ struct Bound {
 // A band around a value approved at bless time: [v·(1 − below) − abs, v·(1 + above) + abs].
 struct Band {
     double below = 0.1, above = 0.1, abs = 0.0;
-};
-
-struct Check {
-    std::string metric; // "flip.mean", "accuracy.flip.mean", "cost.spirv_instructions_per_pixel"
-    double value = 0;
-    std::optional<double> min, max; // the interval the value had to lie in
-    std::optional<double> approved; // bands and costs: the approved figure the interval is built on
-    Verdict status = Verdict::pass; // pass, improved or fail
-    std::string message;            // empty on pass
 };
 
 // Larger is better for SSIM and PSNR; smaller for FLIP and costs.
@@ -58,19 +47,6 @@ Check judge_cost(const std::string& metric, double value, double approved, doubl
 // metrics["flip"]["mean"]. A missing or null metric reads as NaN (and so fails its check).
 double metric_value(const nlohmann::json& metrics, const std::string& key);
 
-// One comparison of the render against one golden.
-struct Comparison {
-    std::string kind;       // "baseline" or "reference"
-    std::string golden;     // path relative to the golden root
-    std::string label;      // baseline@label, "" for the primary
-    nlohmann::json metrics; // compare_images() output; null when the sizes differ
-    std::vector<Check> checks;
-    Verdict verdict = Verdict::pass;
-    std::string message;        // the failing checks, joined
-    nlohmann::json images;      // report images (test/golden/heatmap), set by the runner
-    nlohmann::json worst_block; // {x, y, flip, sphere}: the worst 16x16 block, set by the runner
-};
-
 // Every tolerance of a baseline comparison. Sizes must match: a size mismatch is a failed "size"
 // check naming both sizes (the caller passes the sizes; metrics may then be null).
 Comparison judge_baseline(const nlohmann::json& metrics, const std::map<std::string, Bound>& tolerances);
@@ -85,8 +61,5 @@ Verdict overall_verdict(const std::vector<Verdict>& verdicts);
 // Any-of-several baselines: the test passes if one approved baseline passes; otherwise the
 // closest (lowest FLIP mean) failing one is reported. Returns the index of the chosen comparison.
 size_t choose_baseline(const std::vector<Comparison>& candidates);
-
-nlohmann::json to_json(const Check& c);
-nlohmann::json to_json(const Comparison& c);
 
 } // namespace iblcheck
