@@ -89,21 +89,6 @@ Comparison judge_against_baseline(const TestCase& tc, const RenderResult& rr, co
     return c;
 }
 
-// One check per cost figure of the render against the figure the baseline approved.
-std::vector<Check> judge_costs(const TestCase& tc, const RenderResult& rr, const Golden& golden) {
-    std::vector<Check> out;
-    const json now = render_cost(rr), approved = golden.provenance.value("cost", json::object());
-    for (auto& [key, value] : now.items()) {
-        if (!approved.contains(key) || !approved[key].is_number())
-            throw InputError(fmt::format("{}: \"cost\" has no number for \"{}\" (every baseline records the cost it approved); "
-                                         "re-create it with: {}",
-                                         fs::path(golden.image_path).replace_extension(".json").string(), key,
-                                         bless_command(tc)));
-        out.push_back(judge_cost("cost." + key, value.get<double>(), approved[key].get<double>(), tc.max_cost_growth));
-    }
-    return out;
-}
-
 } // namespace
 
 BaselineOutcome judge_against_baselines(const TestCase& tc, const RenderResult& rr, const GoldenStore& store,
@@ -125,15 +110,14 @@ BaselineOutcome judge_against_baselines(const TestCase& tc, const RenderResult& 
 }
 
 Comparison cost_comparison(const TestCase& tc, const RenderResult& rr, const BaselineOutcome& base) {
-    Comparison cost;
-    cost.kind = "cost";
-    cost.golden = base.comparison.golden;
-    cost.checks = judge_costs(tc, rr, base.golden);
-    for (const Check& k : cost.checks) {
-        cost.message += k.message.empty() ? "" : (cost.message.empty() ? "" : "; ") + k.message;
-        cost.verdict = overall_verdict({cost.verdict, k.status});
-    }
-    return cost;
+    CostJudgement cost = judge_costs(render_cost(rr), base.golden.provenance.value("cost", json::object()), tc.max_cost_growth);
+    if (!cost.unapproved.empty())
+        throw InputError(fmt::format("{}: \"cost\" has no number for \"{}\" (every baseline records the cost it approved); "
+                                     "re-create it with: {}",
+                                     fs::path(base.golden.image_path).replace_extension(".json").string(), cost.unapproved,
+                                     bless_command(tc)));
+    cost.comparison.golden = base.comparison.golden;
+    return std::move(cost.comparison);
 }
 
 TruthComparison judge_against_truth(const TestCase& tc, const RenderResult& rr, const Golden& ref, const GoldenStore& store,

@@ -184,19 +184,15 @@ void check_temporal(TestRun& t) {
 void check_stability(TestRun& t, const cv::Mat& image, const cv::Mat& reference, const BaselineOutcome& base) {
     StabilityOutcome s = run_stability(t.tc, t.w, image, reference, approved_accuracy(base), t.flip_threads);
     t.r.stability = s.json;
-    bool fails = !s.deterministic || (s.flaky && t.tc.stability.fail_on_flaky);
-    t.add(fails ? Verdict::fail : Verdict::pass, s.problem);
+    t.add(stability_verdict(s.deterministic, s.flaky, t.tc.stability.fail_on_flaky), s.problem);
 }
 
 // The test's verdict (the worst found) and its message (every problem; the platform difference
 // too when the test did not pass).
 Verdict decide(TestRun& t) {
-    const Verdict v = t.r.verdict = overall_verdict(t.verdicts);
-    std::string msg;
-    for (auto& p : t.problems) msg += (msg.empty() ? "" : "; ") + p;
-    if (t.r.driver_mismatch && v != Verdict::pass) msg += (msg.empty() ? "" : "; ") + *t.r.driver_mismatch;
-    t.r.message = msg;
-    return v;
+    t.r.verdict = overall_verdict(t.verdicts);
+    t.r.message = test_message(t.problems, t.r.verdict, t.r.driver_mismatch);
+    return t.r.verdict;
 }
 
 TestResult run_test_stages(const TestCase& tc, Worker& w, const GoldenStore& store, const std::filesystem::path& out_dir,
@@ -218,18 +214,18 @@ TestResult run_test_stages(const TestCase& tc, Worker& w, const GoldenStore& sto
         if (tc.stability.enabled) check_stability(t, rr.image, reference, base);
     } catch (const ShaderCompileError& e) {
         shader_error = true;
-        t.add(Verdict::error, std::string("shader compile failed: ") + e.what());
+        t.add(stop_verdict(TestStop::shader_compile_error), std::string("shader compile failed: ") + e.what());
     } catch (const NonFiniteRender& e) {
-        t.add(Verdict::fail, e.what());
+        t.add(stop_verdict(TestStop::non_finite_render), e.what());
     } catch (const std::exception& e) {
-        t.add(Verdict::error, e.what());
+        t.add(stop_verdict(TestStop::cannot_test), e.what());
     }
     // A test that did not pass keeps its render at full precision beside the results. This runs on a
     // worker thread: an exception here (a full disk) used to escape it and abort the run (SIGABRT).
     if (decide(t) != Verdict::pass && t.art && !image.empty()) try {
             t.art.keep_float_render(image);
         } catch (const std::exception& e) {
-            t.add(Verdict::error, e.what());
+            t.add(stop_verdict(TestStop::cannot_test), e.what());
             decide(t);
         }
     return std::move(t.r);

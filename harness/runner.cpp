@@ -99,13 +99,7 @@ void record_run(RunSummary& s, const std::string& suite, const RunOptions& o, Po
     run.cpu_features = prov["cpu_features"];
     run.cpu_class = prov["cpu_class"].get<std::string>();
     run.shard = fmt::format("{}/{}", o.shard_index, o.shard_count);
-    for (const TestResult& r : pool.results) {
-        s.pass += r.verdict == Verdict::pass;
-        s.fail += r.verdict == Verdict::fail;
-        s.improved += r.verdict == Verdict::improved;
-        s.missing += r.verdict == Verdict::missing_golden;
-        s.error += r.verdict == Verdict::error;
-    }
+    for (const TestResult& r : pool.results) s.add(r.verdict);
     run.tests = std::move(pool.results);
     s.results = to_json(run);
     s.shader_compile_error = pool.shader_error;
@@ -166,11 +160,7 @@ std::vector<std::vector<size_t>> precompute_batches(const std::vector<TestCase>&
     return batches;
 }
 
-int RunSummary::exit_code() const {
-    if (error) return kExitError;
-    if (fail || missing) return kExitRegression;
-    return kExitPass;
-}
+int RunSummary::exit_code() const { return run_exit_code(*this); }
 
 // The suite's history file beside --out when the run names none (suite.h: Suite::history).
 RunOptions with_suite_history(RunOptions o, const Suite& suite) {

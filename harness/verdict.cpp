@@ -164,4 +164,61 @@ size_t choose_baseline(const std::vector<Comparison>& candidates) {
     return best;
 }
 
+CostJudgement judge_costs(const json& cost, const json& approved_cost, double max_growth) {
+    CostJudgement out;
+    out.comparison.kind = "cost";
+    for (auto& [key, value] : cost.items()) {
+        if (!approved_cost.is_object() || !approved_cost.contains(key) || !approved_cost[key].is_number()) {
+            out.unapproved = key;
+            return out;
+        }
+        out.comparison.checks.push_back(
+            judge_cost("cost." + key, value.get<double>(), approved_cost[key].get<double>(), max_growth));
+    }
+    conclude(out.comparison);
+    return out;
+}
+
+Verdict stop_verdict(TestStop stop) { return stop == TestStop::non_finite_render ? Verdict::fail : Verdict::error; }
+
+Verdict stability_verdict(bool deterministic, bool flaky, bool fail_on_flaky) {
+    return !deterministic || (flaky && fail_on_flaky) ? Verdict::fail : Verdict::pass;
+}
+
+std::string test_message(const std::vector<std::string>& problems, Verdict verdict,
+                         const std::optional<std::string>& driver_mismatch) {
+    std::string msg;
+    for (const std::string& p : problems) msg += (msg.empty() ? "" : "; ") + p;
+    if (driver_mismatch && verdict != Verdict::pass) msg += (msg.empty() ? "" : "; ") + *driver_mismatch;
+    return msg;
+}
+
+void VerdictCounts::add(Verdict v) {
+    pass += v == Verdict::pass;
+    fail += v == Verdict::fail;
+    improved += v == Verdict::improved;
+    missing += v == Verdict::missing_golden;
+    error += v == Verdict::error;
+}
+
+int run_exit_code(const VerdictCounts& c) {
+    if (c.error) return kExitError;
+    if (c.fail || c.missing) return kExitRegression;
+    return kExitPass;
+}
+
+int repeat_exit_code(int exit_code, int verdicts_changed) {
+    return verdicts_changed && exit_code == kExitPass ? kExitRegression : exit_code;
+}
+
+int bisect_exit_code(const VerdictCounts& c, bool shader_compile_error) {
+    if (shader_compile_error || c.error) return kExitCannotTest;
+    if (c.fail) return kExitRegression;
+    return c.missing ? kExitCannotTest : kExitPass;
+}
+
+std::string_view bisect_verdict_name(int exit_code) {
+    return exit_code == kExitPass ? "good" : exit_code == kExitRegression ? "bad" : "skip (125)";
+}
+
 } // namespace iblcheck
