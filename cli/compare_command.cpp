@@ -17,8 +17,7 @@
 #include "kernel/input_file.h"
 #include "kernel/output_files.h"
 #include "metrics/flip.h"
-#include "metrics/flip_json.h"
-#include "metrics/psnr.h"
+#include "metrics/image_compare.h"
 #include "metrics/ssim.h"
 
 namespace iblcheck {
@@ -33,8 +32,10 @@ std::string lower_ext(const std::string& path) {
     return e;
 }
 
-// JSON cannot hold inf (identical images give PSNR = +inf): write null.
-nlohmann::json num(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+// "inf" for identical images (kPsnrIdentical), else the figure.
+std::string db_text(const nlohmann::json& db) {
+    return db.get<double>() == kPsnrIdentical ? std::string("inf") : fmt::format("{:.4f}", db.get<double>());
+}
 
 } // namespace
 
@@ -47,6 +48,21 @@ struct PairResult {
     bool hdr = false;
     size_t clamped[2] = {0, 0};
 };
+
+// The comparison `run` makes (metrics/image_compare.h), so a key means the same in both, with what
+// only the command line chooses: FLIP's ppd, tone mapper and exposures, LDR inputs, and the PSNR of
+// the radiance itself ("linear_psnr").
+CompareOptions compare_options(const CompareArgs& a, bool hdr, flip::ToneMapper tm) {
+    CompareOptions o;
+    o.hdr = hdr;
+    if (a.ppd > 0) o.flip_options.ppd = a.ppd;
+    o.flip_options.tone_mapper = tm;
+    o.flip_options.start_exposure = a.start_exposure;
+    o.flip_options.stop_exposure = a.stop_exposure;
+    o.flip_options.threads = a.threads;
+    o.linear_psnr = true;
+    return o;
+}
 
 // Reads both images, checks they can be compared, and computes the metrics `a` asks for. Writes the
 // heatmap / error map when asked. Throws iblcheck::Error (or cv::Exception) naming the file.
@@ -99,35 +115,18 @@ PairResult compare_pair(const CompareArgs& a) {
         }
     }
 
+    CompareOptions o = compare_options(a, hdr, tm);
+    o.want_flip = want_flip, o.want_ssim = want_ssim, o.want_psnr = want_psnr;
+    j = compare_images(ref.pixels, test.pixels, o, &fr);
     if (want_flip) {
-        FlipOptions fo;
-        if (a.ppd > 0) fo.ppd = a.ppd;
-        fo.tone_mapper = tm;
-        fo.start_exposure = a.start_exposure;
-        fo.stop_exposure = a.stop_exposure;
-        fo.threads = a.threads;
-        fr = hdr ? compute_flip_hdr(ref.pixels, test.pixels, fo) : compute_flip_ldr(ref.pixels, test.pixels, fo);
-        // The shared keys (metrics/flip_json.h), plus what only a command-line comparison chooses.
-        nlohmann::json f = flip_json(fr);
-        f["ppd"] = fr.ppd;
-        if (hdr) f["tone_mapper"] = flip::tone_mapper_name(tm);
-        j["flip"] = f;
+        j["flip"]["ppd"] = fr.ppd;
+        if (hdr) j["flip"]["tone_mapper"] = flip::tone_mapper_name(tm);
         if (!a.heatmap.empty()) write_png(a.heatmap, magma_heatmap(fr.errmap));
         if (!a.errmap.empty()) write_exr(a.errmap, fr.errmap);
     }
-    if (want_ssim && !ssim_applicable(ref.pixels)) {
-        j["ssim"] = {{"mean", nullptr},
-                     {"not_applicable", fmt::format("{}x{} is smaller than SSIM's {}x{} window", ref.pixels.cols, ref.pixels.rows,
-                                                    kSsimMinSize, kSsimMinSize)}};
-    } else if (want_ssim) {
-        const SsimResult s = hdr ? compute_ssim_hdr(ref.pixels, test.pixels) : compute_ssim(ref.pixels, test.pixels);
-        j["ssim"] = {{"mean", s.mean}};
-    }
-    if (want_psnr) {
-        const PsnrResult p = compute_psnr(ref.pixels, test.pixels);
-        j["psnr"] = {{"db", num(p.db)}, {"rmse", p.rmse}, {"max_abs", p.max_abs}};
-        if (hdr) j["psnr"]["relative_mse"] = compute_relative_mse(ref.pixels, test.pixels);
-    }
+    if (want_ssim && j["ssim"]["mean"].is_null()) // the sizes, for the person who gave the files
+        j["ssim"]["not_applicable"] = fmt::format("{}x{} is smaller than SSIM's {}x{} window", ref.pixels.cols, ref.pixels.rows,
+                                                  kSsimMinSize, kSsimMinSize);
     if (clamped[0] || clamped[1]) j["clamped_negative"] = {{"reference", clamped[0]}, {"test", clamped[1]}};
     return res;
 }
@@ -165,9 +164,14 @@ int run_compare(const CompareArgs& a, std::ostream& out, std::ostream& err) {
                             : fmt::format("SSIM {:.6f}\n", j["ssim"]["mean"].get<double>()));
             if (want_psnr) {
                 const auto& p = j["psnr"];
-                out << fmt::format("PSNR {} dB  RMSE {:.6f}  max |diff| {:.6f}\n",
-                                   p["db"].is_null() ? std::string("inf") : fmt::format("{:.4f}", p["db"].get<double>()),
-                                   p["rmse"].get<double>(), p["max_abs"].get<double>());
+                out << fmt::format("PSNR {} dB  RMSE {:.6f}  max |diff| {:.6f}{}\n", db_text(p["db"]), p["rmse"].get<double>(),
+                                   p["max_abs"].get<double>(), hdr ? "  (after the display transform, as `run`)" : "");
+            }
+            if (want_psnr && hdr) {
+                const auto& p = j["linear_psnr"];
+                out << fmt::format("linear PSNR {} dB  RMSE {:.6f}  max |diff| {:.6f}  relative MSE {:.6f}  (the radiance)\n",
+                                   db_text(p["db"]), p["rmse"].get<double>(), p["max_abs"].get<double>(),
+                                   p["relative_mse"].get<double>());
             }
         }
         return kExitPass;

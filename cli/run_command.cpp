@@ -38,7 +38,7 @@ void repeat_runs(const RunOptions& run, RunSummary& first, int repeat, int& exit
             }
         }
         fmt::print("repeat {}/{}: {} verdict(s) changed\n", k + 1, repeat, changed);
-        if (changed && exit_code == kExitPass) exit_code = kExitRegression;
+        exit_code = repeat_exit_code(exit_code, changed);
     }
 }
 
@@ -135,19 +135,12 @@ void register_bisect(CLI::App& app, int& exit_code) {
             sum = run_suite(bis);
         } catch (const std::exception& e) {
             fmt::print(stderr, "cannot test: {}\n", e.what());
-            fmt::print("bisect verdict: skip (125)\n");
             exit_code = kExitCannotTest;
+            fmt::print("bisect verdict: {}\n", bisect_verdict_name(exit_code));
             return;
         }
-        // A test without an approved golden in --goldens cannot be judged either (a goldens folder
-        // from before the test existed made every commit "bad").
-        if (sum.shader_compile_error || sum.error)
-            exit_code = kExitCannotTest;
-        else if (sum.fail)
-            exit_code = kExitRegression;
-        else
-            exit_code = sum.missing ? kExitCannotTest : kExitPass;
-        fmt::print("bisect verdict: {}\n", exit_code == 0 ? "good" : exit_code == 1 ? "bad" : "skip (125)");
+        exit_code = bisect_exit_code(sum, sum.shader_compile_error); // harness/verdict.h
+        fmt::print("bisect verdict: {}\n", bisect_verdict_name(exit_code));
     });
 }
 

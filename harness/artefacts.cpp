@@ -1,11 +1,11 @@
 #include "artefacts.h"
 
 #include "golden_store.h"
-#include "image_compare.h"
 #include "image_io/image_io.h"
 #include "kernel/atomic_file.h"
 #include "kernel/profile.h"
 #include "metrics/display_transform.h"
+#include "sphere_errors.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;

@@ -13,12 +13,13 @@
 #include <regex>
 
 #include "golden_store.h"
-#include "image_compare.h"
 #include "image_io/image_io.h"
 #include "kernel/errors.h"
 #include "kernel/input_file.h"
 #include "kernel/program.h"
 #include "kernel/shell_quote.h"
+#include "metrics/catalog.h"
+#include "metrics/image_compare.h"
 #include "provenance.h"
 #include "renderers/environments/environment.h"
 #include "verdict.h"
@@ -62,15 +63,9 @@ json approved_accuracy(const GoldenStore& store, const TestCase& tc, const Rende
         throw InputError(fmt::format("{}: {}x{}, but the render is {}x{}", ref->image_path.string(), ref->image.cols,
                                      ref->image.rows, image.cols, image.rows));
     json m = compare_images(ref->image, image, 0, nullptr, tc.display ? &*tc.display : nullptr);
-    json a = {{"flip.mean", m["flip"]["mean"]},
-              {"flip.p99", m["flip"]["p99"]},
-              {"flip.block_max", m["flip"]["block_max"]},
-              {"ssim.mean", m["ssim"]["mean"]},
-              {"psnr.db", m["psnr"]["db"]}};
-    if (tc.display) // the accuracy a display test's reference_band is built on
-        for (const char* k :
-             {"display_flip.mean", "display_flip.p99", "display_flip.block_max", "display_ssim.mean", "display_psnr.db"})
-            a[k] = metric_value(m, k);
+    json a = json::object();
+    for (const MetricInfo* k : judged_metrics(tc.display.has_value())) // a display test's reference_band: its display figures too
+        a[k->key] = m[k->group][k->field];
     return a;
 }
 

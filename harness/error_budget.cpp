@@ -6,8 +6,8 @@
 
 #include <fmt/format.h>
 
-#include "harness/image_compare.h"
 #include "kernel/errors.h"
+#include "metrics/image_compare.h"
 #include "renderers/option_table.h"
 #include "renderers/scenes/scene.h"
 

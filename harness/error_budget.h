@@ -53,7 +53,7 @@ BudgetPlan plan_budget(const std::string& scene, const std::string& env, const O
 
 // A render's error against the truth, per sphere (sphere at the pixel centre, coverage.ids) and over
 // every covered pixel: signed relative bias Σ(t − r)/Σr, relative RMSE √(mean (t − r)²)/mean r (the
-// three channels pooled), mean HDR-FLIP (the runner's: image_compare.h).
+// three channels pooled), mean HDR-FLIP (the runner's: metrics/image_compare.h).
 struct ErrorFigures {
     double bias = 0, rmse = 0, flip = 0;
 };

@@ -6,10 +6,12 @@
 #include <cstring>
 
 #include "bless.h"
-#include "image_compare.h"
 #include "kernel/errors.h"
 #include "kernel/profile.h"
+#include "metrics/catalog.h"
+#include "metrics/image_compare.h"
 #include "provenance.h"
+#include "sphere_errors.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -25,11 +27,7 @@ namespace {
 void note_worst_block(Comparison& c, const SphereCoverage& coverage, const FlipResult& flip, bool display) {
     const int width = coverage.ids.cols, height = coverage.ids.rows;
     std::string sphere = sphere_at(coverage, std::min(flip.block_x + 8, width - 1), std::min(flip.block_y + 8, height - 1));
-    c.worst_block = {{"x", flip.block_x},
-                     {"y", flip.block_y},
-                     {"flip", flip.block_max},
-                     {"metric", display ? "display_flip" : "flip"},
-                     {"sphere", sphere}};
+    c.worst_block = WorstBlock{flip.block_x, flip.block_y, flip.block_max, display ? "display_flip" : "flip", sphere};
     if (c.verdict == Verdict::fail)
         c.message +=
             fmt::format("; worst 16x16 block at ({},{}){} with mean {} {:.4g}", flip.block_x, flip.block_y,
@@ -50,6 +48,17 @@ json measure(const TestCase& tc, const cv::Mat& golden, const cv::Mat& image, in
     }
     m.update(compare_in_display(golden, image, *tc.display, flip_threads, &shown));
     return m;
+}
+
+// The test's accuracy against its truth: mean HDR-FLIP and SSIM, linear; a display test adds the
+// same comparison as a player sees it (LDR-FLIP, SSIM and PSNR of both after the display).
+Accuracy accuracy_of(const TestCase& tc, const json& metrics, const FlipResult& flip, const std::string& golden,
+                     const json& noise_floor) {
+    Accuracy a{flip.mean, metric_value(metrics, "ssim.mean"), golden, noise_floor, std::nullopt};
+    if (tc.display)
+        a.display = DisplayAccuracy{metrics.value("display", json()), metric_value(metrics, "display_flip.mean"),
+                                    metric_value(metrics, "display_ssim.mean"), metric_value(metrics, "display_psnr.db")};
+    return a;
 }
 
 BaselineOutcome missing_baseline(const TestCase& tc, const GoldenStore& store) {
@@ -82,21 +91,6 @@ Comparison judge_against_baseline(const TestCase& tc, const RenderResult& rr, co
     return c;
 }
 
-// One check per cost figure of the render against the figure the baseline approved.
-std::vector<Check> judge_costs(const TestCase& tc, const RenderResult& rr, const Golden& golden) {
-    std::vector<Check> out;
-    const json now = render_cost(rr), approved = golden.provenance.value("cost", json::object());
-    for (auto& [key, value] : now.items()) {
-        if (!approved.contains(key) || !approved[key].is_number())
-            throw InputError(fmt::format("{}: \"cost\" has no number for \"{}\" (every baseline records the cost it approved); "
-                                         "re-create it with: {}",
-                                         fs::path(golden.image_path).replace_extension(".json").string(), key,
-                                         bless_command(tc)));
-        out.push_back(judge_cost("cost." + key, value.get<double>(), approved[key].get<double>(), tc.max_cost_growth));
-    }
-    return out;
-}
-
 } // namespace
 
 BaselineOutcome judge_against_baselines(const TestCase& tc, const RenderResult& rr, const GoldenStore& store,
@@ -118,46 +112,39 @@ BaselineOutcome judge_against_baselines(const TestCase& tc, const RenderResult& 
 }
 
 Comparison cost_comparison(const TestCase& tc, const RenderResult& rr, const BaselineOutcome& base) {
-    Comparison cost;
-    cost.kind = "cost";
-    cost.golden = base.comparison.golden;
-    cost.checks = judge_costs(tc, rr, base.golden);
-    for (const Check& k : cost.checks) {
-        cost.message += k.message.empty() ? "" : (cost.message.empty() ? "" : "; ") + k.message;
-        cost.verdict = overall_verdict({cost.verdict, k.status});
-    }
-    return cost;
+    CostJudgement cost = judge_costs(render_cost(rr), base.golden.provenance.value("cost", json::object()), tc.max_cost_growth);
+    if (!cost.unapproved.empty())
+        throw InputError(fmt::format("{}: \"cost\" has no number for \"{}\" (every baseline records the cost it approved); "
+                                     "re-create it with: {}",
+                                     fs::path(base.golden.image_path).replace_extension(".json").string(), cost.unapproved,
+                                     bless_command(tc)));
+    cost.comparison.golden = base.comparison.golden;
+    return std::move(cost.comparison);
 }
 
-Comparison judge_against_truth(const TestCase& tc, const RenderResult& rr, const Golden& ref, const GoldenStore& store,
-                               const json& approved_accuracy, const Artefacts& art, int flip_threads, json& r) {
+TruthComparison judge_against_truth(const TestCase& tc, const RenderResult& rr, const Golden& ref, const GoldenStore& store,
+                                    const json& approved_accuracy, const Artefacts& art, int flip_threads) {
     const cv::Mat& image = rr.image;
+    TruthComparison out;
+    Comparison& c = out.comparison;
     if (ref.image.size() != image.size()) {
-        Comparison c = judge_size("reference", image.cols, image.rows, ref.image.cols, ref.image.rows);
+        c = judge_size("reference", image.cols, image.rows, ref.image.cols, ref.image.rows);
         c.golden = store.relative(ref.image_path);
-        return c;
+        return out;
     }
     FlipResult flip, shown;
-    json metrics = measure(tc, ref.image, image, flip_threads, flip, shown);
-    Comparison c = judge_reference(metrics, approved_accuracy, tc.reference_band);
+    const json metrics = measure(tc, ref.image, image, flip_threads, flip, shown);
+    c = judge_reference(metrics, approved_accuracy, tc.reference_band);
     c.golden = store.relative(ref.image_path);
     note_worst_block(c, rr.coverage, shown, tc.display.has_value());
-    r["accuracy"] = {{"flip_mean", flip.mean},
-                     {"ssim", metrics["ssim"]["mean"]},
-                     {"golden", c.golden},
-                     {"noise_floor", ref.provenance.value("noise_floor", json())}};
-    if (tc.display) // the truth as a player sees it: LDR-FLIP, SSIM and PSNR of both after the display
-        r["accuracy"]["display"] = {{"space", metrics["display"]},
-                                    {"flip_mean", metrics["display_flip"]["mean"]},
-                                    {"ssim", metrics["display_ssim"]["mean"]},
-                                    {"psnr_db", metrics["display_psnr"]["db"]}};
-    if (json ps = per_sphere_errors(rr.coverage, flip.errmap); !ps.is_null()) r["per_sphere"] = ps;
+    out.accuracy = accuracy_of(tc, metrics, flip, c.golden, ref.provenance.value("noise_floor", json()));
+    out.per_sphere = per_sphere_errors(rr.coverage, flip.errmap);
     if (art) {
         c.images = Artefacts::images(art.rel + "test.png", art.png("reference.png", ref.image, false),
                                      art.heatmap("reference_flip.png", shown.errmap));
         c.images["golden_exr"] = art.shared_exr(c.golden, ref.image);
     }
-    return c;
+    return out;
 }
 
 } // namespace iblcheck

@@ -26,48 +26,44 @@ namespace iblcheck {
 namespace {
 
 // What the test is, before anything is rendered.
-json test_header(const TestCase& tc, const GoldenStore& store) {
-    return {{"name", tc.name},
-            {"suite", tc.suite},
-            {"scene", tc.spec.scene},
-            {"method", tc.spec.method},
-            {"env", environment_label(tc.spec.env, tc.spec.env_name)},
-            {"options", tc.spec.options.values()},
-            {"variant", tc.variant},
-            {"display", tc.display ? display_json(*tc.display) : json()},
-            {"tags", tc.tags},
-            {"bless_command", bless_command(tc, store)},
-            {"comparisons", json::array()},
-            {"accuracy", nullptr},
-            {"driver_mismatch", nullptr}};
+TestResult test_header(const TestCase& tc, const GoldenStore& store) {
+    TestResult r;
+    r.name = tc.name;
+    r.suite = tc.suite;
+    r.scene = tc.spec.scene;
+    r.method = tc.spec.method;
+    r.env = environment_label(tc.spec.env, tc.spec.env_name);
+    r.options = tc.spec.options.values();
+    r.variant = tc.variant;
+    r.display = tc.display ? display_json(*tc.display) : json();
+    r.tags = tc.tags;
+    r.bless_command = bless_command(tc, store);
+    return r;
 }
 
-void record_render(json& r, const RenderResult& rr) {
-    r["width"] = rr.image.cols;
-    r["height"] = rr.image.rows;
-    double pre = 0, frame = 0;
-    json t = json::array();
+RenderFigures render_figures(const RenderResult& rr) {
+    RenderFigures f;
+    f.width = rr.image.cols;
+    f.height = rr.image.rows;
     for (auto& p : rr.timings) {
-        t.push_back({{"pass", p.name}, {"ms", p.ms}, {"gpu", p.gpu}, {"precompute", p.precompute}});
-        (p.precompute ? pre : frame) += p.ms;
+        f.timings.push_back({p.name, p.ms, p.gpu, p.precompute});
+        (p.precompute ? f.precompute_ms : f.frame_ms) += p.ms;
     }
-    r["timings"] = t;
-    r["precompute_ms"] = pre;
-    r["frame_ms"] = frame;
-    r["texture_fetches_per_pixel"] = rr.texture_fetches_per_pixel;
+    f.texture_fetches_per_pixel = rr.texture_fetches_per_pixel;
     if (rr.texture_bytes > 0) { // the bytes/accuracy chart's x (mobile: the prefiltered chain)
-        r["texture_bytes"] = rr.texture_bytes;
-        r["texel_count"] = rr.texel_count;
+        f.texture_bytes = rr.texture_bytes;
+        f.texel_count = rr.texel_count;
     }
-    r["cost"] = render_cost(rr);
-    r["provenance"] = rr.provenance;
+    f.cost = render_cost(rr);
+    f.provenance = rr.provenance;
+    return f;
 }
 
-// Per-frame time of `repeats` renders in all (the first one already recorded in r): wall times
-// vary 2-5x on a loaded machine, so the results keep every sample and report their median.
-void repeat_timings(json& r, const TestCase& tc, Worker& w, int repeats) {
+// Per-frame time of `repeats` renders in all (the first one already recorded in `figures`): wall
+// times vary 2-5x on a loaded machine, so the results keep every sample and report their median.
+void repeat_timings(RenderFigures& figures, const TestCase& tc, Worker& w, int repeats) {
     if (repeats < 2) return;
-    std::vector<double> frame{r["frame_ms"].get<double>()};
+    std::vector<double> frame{figures.frame_ms};
     for (int k = 1; k < repeats; ++k) {
         double f = 0;
         for (auto& p : w.renderer.render(tc.spec).timings) f += p.precompute ? 0 : p.ms;
@@ -75,8 +71,8 @@ void repeat_timings(json& r, const TestCase& tc, Worker& w, int repeats) {
     }
     std::sort(frame.begin(), frame.end());
     const size_t n = frame.size();
-    r["frame_ms_samples"] = frame;
-    r["frame_ms"] = n % 2 ? frame[n / 2] : 0.5 * (frame[n / 2 - 1] + frame[n / 2]);
+    figures.frame_ms_samples = frame;
+    figures.frame_ms = n % 2 ? frame[n / 2] : 0.5 * (frame[n / 2 - 1] + frame[n / 2]);
 }
 
 // One test under way: what its checks read, and what they found (the verdicts in order and the
@@ -87,7 +83,7 @@ struct TestRun {
     const GoldenStore& store;
     Artefacts art;
     int flip_threads;
-    json r; // the results object
+    TestResult r;
     std::vector<Verdict> verdicts;
     std::vector<std::string> problems;
 
@@ -99,9 +95,9 @@ struct TestRun {
 
 // The render as the report shows it: test.png (+ its EXR) and which sphere is where.
 void record_images(TestRun& t, const RenderResult& rr) {
-    t.r["image"] = t.art.png("test.png", rr.image);
-    t.r["image_exr"] = Artefacts::exr(t.r["image"]);
-    t.r["layout"] = t.art.layout(rr.coverage);
+    t.r.image = t.art.png("test.png", rr.image);
+    t.r.image_exr = Artefacts::exr(*t.r.image);
+    t.r.layout = t.art.layout(rr.coverage);
 }
 
 // A file environment must be the one the golden was made from (its content hash in the sidecar): an
@@ -118,7 +114,7 @@ void check_environment_unchanged(const TestCase& tc, const RenderResult& rr, con
 // blessed on (a difference is named in the message of a test that does not pass).
 BaselineOutcome check_baselines(TestRun& t, const RenderResult& rr) {
     BaselineOutcome base = judge_against_baselines(t.tc, rr, t.store, t.art, t.flip_threads);
-    t.r["comparisons"].push_back(to_json(base.comparison));
+    t.r.comparisons.push_back(base.comparison);
     if (base.missing) {
         t.add(base.comparison.verdict, base.comparison.message);
         return base;
@@ -131,13 +127,13 @@ BaselineOutcome check_baselines(TestRun& t, const RenderResult& rr) {
                                                                       : ""),
         base.golden.image_path,
         t.tc.reference ? "re-render its truth: " + truth_command(t.tc.spec, t.store) + " --force; " + rebless : rebless);
-    t.r["comparisons"].back()["approved"] = baseline_facts(base.golden.provenance);
+    t.r.comparisons.back().approved = baseline_facts(base.golden.provenance);
     t.add(base.comparison.verdict, base.comparison.message.empty() ? "" : "baseline: " + base.comparison.message);
     const Comparison cost = cost_comparison(t.tc, rr, base);
-    t.r["comparisons"].push_back(to_json(cost));
+    t.r.comparisons.push_back(cost);
     t.add(cost.verdict, cost.message);
     std::string diff = platform_difference(base.golden.provenance, rr.provenance, this_cpu_class());
-    if (!diff.empty()) t.r["driver_mismatch"] = diff;
+    if (!diff.empty()) t.r.driver_mismatch = diff;
     return base;
 }
 
@@ -171,69 +167,65 @@ cv::Mat check_reference(TestRun& t, const RenderResult& rr, const BaselineOutcom
     check_environment_unchanged(t.tc, rr, truth_env_hash(ref->provenance), ref->image_path,
                                 "re-render the truth with: " + truth_command(t.tc.spec, t.store));
     check_approved_accuracy(t, base);
-    Comparison c = judge_against_truth(t.tc, rr, *ref, t.store, approved_accuracy(base), t.art, t.flip_threads, t.r);
-    t.r["comparisons"].push_back(to_json(c));
+    TruthComparison truth = judge_against_truth(t.tc, rr, *ref, t.store, approved_accuracy(base), t.art, t.flip_threads);
+    t.r.accuracy = truth.accuracy;
+    t.r.per_sphere = truth.per_sphere;
+    const Comparison& c = t.r.comparisons.emplace_back(std::move(truth.comparison));
     t.add(c.verdict, c.message.empty() ? "" : "accuracy: " + c.message);
     return ref->image;
 }
 
 void check_temporal(TestRun& t) {
     TemporalOutcome o = run_temporal(t.tc, t.w, t.store, t.art.dir, t.art.rel, t.flip_threads);
-    t.r["temporal"] = o.json;
+    t.r.temporal = o.json;
     for (const Check& k : o.checks) t.add(k.status, k.message.empty() ? "" : "temporal: " + k.message);
 }
 
 void check_stability(TestRun& t, const cv::Mat& image, const cv::Mat& reference, const BaselineOutcome& base) {
     StabilityOutcome s = run_stability(t.tc, t.w, image, reference, approved_accuracy(base), t.flip_threads);
-    t.r["stability"] = s.json;
-    bool fails = !s.deterministic || (s.flaky && t.tc.stability.fail_on_flaky);
-    t.add(fails ? Verdict::fail : Verdict::pass, s.problem);
+    t.r.stability = s.json;
+    t.add(stability_verdict(s.deterministic, s.flaky, t.tc.stability.fail_on_flaky), s.problem);
 }
 
 // The test's verdict (the worst found) and its message (every problem; the platform difference
 // too when the test did not pass).
 Verdict decide(TestRun& t) {
-    Verdict v = overall_verdict(t.verdicts);
-    t.r["verdict"] = verdict_name(v);
-    std::string msg;
-    for (auto& p : t.problems) msg += (msg.empty() ? "" : "; ") + p;
-    if (t.r["driver_mismatch"].is_string() && v != Verdict::pass)
-        msg += (msg.empty() ? "" : "; ") + t.r["driver_mismatch"].get<std::string>();
-    t.r["message"] = msg;
-    return v;
+    t.r.verdict = overall_verdict(t.verdicts);
+    t.r.message = test_message(t.problems, t.r.verdict, t.r.driver_mismatch);
+    return t.r.verdict;
 }
 
-json run_test_stages(const TestCase& tc, Worker& w, const GoldenStore& store, const std::filesystem::path& out_dir,
-                     int flip_threads, int timing_repeats, bool& shader_error) {
+TestResult run_test_stages(const TestCase& tc, Worker& w, const GoldenStore& store, const std::filesystem::path& out_dir,
+                           int flip_threads, int timing_repeats, bool& shader_error) {
     TestRun t{tc, w, store, Artefacts::for_test(out_dir, tc.name), flip_threads, test_header(tc, store), {}, {}};
     cv::Mat image;
     try {
         RenderResult rr = w.renderer.render(tc.spec);
         image = rr.image;
-        record_render(t.r, rr);
-        repeat_timings(t.r, tc, w, timing_repeats);
+        t.r.render = render_figures(rr);
+        repeat_timings(*t.r.render, tc, w, timing_repeats);
         if (NonFinite nf = find_non_finite(rr.image); nf.count) throw NonFiniteRender("render: " + nf.describe());
         if (!rr.non_finite_coverage.empty()) throw NonFiniteRender(rr.non_finite_coverage);
         if (t.art) record_images(t, rr);
         const BaselineOutcome base = tc.baseline ? check_baselines(t, rr) : BaselineOutcome{};
         const cv::Mat reference = tc.reference ? check_reference(t, rr, base) : cv::Mat();
-        if (tc.reference) t.r["furnace"] = furnace_figure(tc, w, store); // energy against the white-furnace truth
+        if (tc.reference) t.r.furnace = furnace_figure(tc, w, store); // energy against the white-furnace truth
         if (tc.temporal.frames > 0) check_temporal(t);
         if (tc.stability.enabled) check_stability(t, rr.image, reference, base);
     } catch (const ShaderCompileError& e) {
         shader_error = true;
-        t.add(Verdict::error, std::string("shader compile failed: ") + e.what());
+        t.add(stop_verdict(TestStop::shader_compile_error), std::string("shader compile failed: ") + e.what());
     } catch (const NonFiniteRender& e) {
-        t.add(Verdict::fail, e.what());
+        t.add(stop_verdict(TestStop::non_finite_render), e.what());
     } catch (const std::exception& e) {
-        t.add(Verdict::error, e.what());
+        t.add(stop_verdict(TestStop::cannot_test), e.what());
     }
     // A test that did not pass keeps its render at full precision beside the results. This runs on a
     // worker thread: an exception here (a full disk) used to escape it and abort the run (SIGABRT).
     if (decide(t) != Verdict::pass && t.art && !image.empty()) try {
             t.art.keep_float_render(image);
         } catch (const std::exception& e) {
-            t.add(Verdict::error, e.what());
+            t.add(stop_verdict(TestStop::cannot_test), e.what());
             decide(t);
         }
     return std::move(t.r);
@@ -241,17 +233,17 @@ json run_test_stages(const TestCase& tc, Worker& w, const GoldenStore& store, co
 
 } // namespace
 
-json run_test(const TestCase& tc, Worker& w, const GoldenStore& store, const std::filesystem::path& out_dir, int flip_threads,
-              int timing_repeats, bool& shader_error) {
+TestResult run_test(const TestCase& tc, Worker& w, const GoldenStore& store, const std::filesystem::path& out_dir,
+                    int flip_threads, int timing_repeats, bool& shader_error) {
     const auto t0 = std::chrono::steady_clock::now();
-    json r;
+    TestResult r;
     {
         ProfileStage stage("test_other"); // what no stage inside names: verdicts, sidecars, the results object
         r = run_test_stages(tc, w, store, out_dir, flip_threads, timing_repeats, shader_error);
     }
     // The whole test, its header included, so that its stages (all inside) add up to at most this.
-    r["wall_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    if (profile::enabled()) r["profile"] = profile::take(); // --profile: seconds per stage (run_profile.h)
+    r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (profile::enabled()) r.profile = profile::take(); // --profile: seconds per stage (run_profile.h)
     return r;
 }
 

@@ -33,7 +33,7 @@ namespace {
 
 // What the workers leave: each test's results object in suite order, and the run's facts.
 struct PoolOutcome {
-    std::vector<json> results;
+    std::vector<TestResult> results;
     json driver;
     bool shader_error = false;
 };
@@ -43,7 +43,7 @@ struct PoolOutcome {
 PoolOutcome run_tests(const std::vector<TestCase>& tests, const RunOptions& o, const fs::path& out_dir, const GoldenStore& store,
                       int jobs, int timing_repeats) {
     const int flip_threads = jobs > 1 ? 1 : 0;
-    std::vector<json> results(tests.size());
+    std::vector<TestResult> results(tests.size());
     const std::vector<std::vector<size_t>> batches = precompute_batches(tests);
     std::atomic<int> done{0};
     std::atomic<bool> shader_error{false};
@@ -64,7 +64,7 @@ PoolOutcome run_tests(const std::vector<TestCase>& tests, const RunOptions& o, c
                 int n = ++done;
                 if (!o.quiet) {
                     std::lock_guard lock(print_mutex);
-                    print_test_line(results[i], n, tests.size(), interactive, budget);
+                    print_test_line(to_json(results[i]), n, tests.size(), interactive, budget);
                 }
             }
         });
@@ -76,29 +76,22 @@ PoolOutcome run_tests(const std::vector<TestCase>& tests, const RunOptions& o, c
 
 // The results document (results/RESULTS_FORMAT.md): the run's facts, every test, the counts.
 void record_run(RunSummary& s, const std::string& suite, const RunOptions& o, PoolOutcome& pool, double total_s) {
-    json& R = s.results;
-    R = {{"schema", "iblcheck-results/1"}, {"suite", suite}, {"command", o.command_line}, {"started", utc_now_iso()}};
-    R["total_s"] = total_s;
+    RunResults run;
+    run.suite = suite;
+    run.command = o.command_line;
+    run.started = utc_now_iso();
+    run.total_s = total_s;
     json prov = run_provenance();
     std::string commit = prov["commit"];
-    R["dirty"] = commit.size() > 6 && commit.substr(commit.size() - 6) == "-dirty";
-    R["commit"] = R["dirty"].get<bool>() ? commit.substr(0, commit.size() - 6) : commit;
-    R["driver"] = pool.driver;
-    R["cpu_features"] = prov["cpu_features"];
-    R["cpu_class"] = prov["cpu_class"];
-    R["shard"] = fmt::format("{}/{}", o.shard_index, o.shard_count);
-    R["tests"] = json::array();
-    for (auto& r : pool.results) {
-        Verdict v = parse_verdict(r["verdict"].get<std::string>());
-        s.pass += v == Verdict::pass;
-        s.fail += v == Verdict::fail;
-        s.improved += v == Verdict::improved;
-        s.missing += v == Verdict::missing_golden;
-        s.error += v == Verdict::error;
-        R["tests"].push_back(r);
-    }
-    R["counts"] = {
-        {"pass", s.pass}, {"fail", s.fail}, {"improved", s.improved}, {"missing-golden", s.missing}, {"error", s.error}};
+    run.dirty = commit.size() > 6 && commit.substr(commit.size() - 6) == "-dirty";
+    run.commit = run.dirty ? commit.substr(0, commit.size() - 6) : commit;
+    run.driver = pool.driver;
+    run.cpu_features = prov["cpu_features"];
+    run.cpu_class = prov["cpu_class"].get<std::string>();
+    run.shard = fmt::format("{}/{}", o.shard_index, o.shard_count);
+    for (const TestResult& r : pool.results) s.add(r.verdict);
+    run.tests = std::move(pool.results);
+    s.results = to_json(run);
     s.shader_compile_error = pool.shader_error;
 }
 
@@ -157,11 +150,7 @@ std::vector<std::vector<size_t>> precompute_batches(const std::vector<TestCase>&
     return batches;
 }
 
-int RunSummary::exit_code() const {
-    if (error) return kExitError;
-    if (fail || missing) return kExitRegression;
-    return kExitPass;
-}
+int RunSummary::exit_code() const { return run_exit_code(*this); }
 
 // The suite's history file beside --out when the run names none (suite.h: Suite::history).
 RunOptions with_suite_history(RunOptions o, const Suite& suite) {

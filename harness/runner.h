@@ -1,4 +1,4 @@
-// Runs a suite: render → metrics (image_compare.h) → verdict (verdict.h) → results JSON (+ JUnit,
+// Runs a suite: render → metrics (metrics/image_compare.h) → verdict (verdict.h) → results JSON (+ JUnit,
 // report, images). The runner knows no Vulkan (it calls Renderer) and writes no goldens (bless.h
 // does). Here: the worker threads and the results document. One test's recipe is one_test.h; its
 // comparisons with the goldens golden_comparisons.h; its image files artefacts.h; stability and
@@ -15,6 +15,7 @@
 #include "golden_store.h"
 #include "results/junit.h"
 #include "suite.h"
+#include "verdict.h"
 
 namespace iblcheck {
 
@@ -40,11 +41,11 @@ struct RunOptions {
     bool profile = false; // print where the time went (run_profile.h); each test's results gain "profile"
 };
 
-struct RunSummary {
+// The run's results (results/results.h, as JSON) and how many tests got each verdict.
+struct RunSummary : VerdictCounts {
     nlohmann::json results;
-    int pass = 0, fail = 0, improved = 0, missing = 0, error = 0;
     bool shader_compile_error = false; // some render failed to compile its shaders (bisect: 125)
-    int exit_code() const;
+    int exit_code() const;             // verdict.h: run_exit_code
 };
 
 RunSummary run_suite(const RunOptions& options);

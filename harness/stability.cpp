@@ -7,7 +7,8 @@
 #include <limits>
 
 #include "child_render.h"
-#include "image_compare.h"
+#include "metrics/catalog.h"
+#include "metrics/image_compare.h"
 #include "verdict.h"
 
 using nlohmann::json;
@@ -15,12 +16,18 @@ using nlohmann::json;
 namespace iblcheck {
 
 namespace {
-// The metrics whose noise floors are measured: a display test's display figures too (issue 29), so
-// its display tolerances get margins like the linear ones.
-std::vector<std::string> floor_metrics(const TestCase& tc) {
-    std::vector<std::string> m = {"flip.mean", "flip.p99", "flip.block_max", "ssim.mean"};
-    if (tc.display) m.insert(m.end(), {"display_flip.mean", "display_flip.p99", "display_flip.block_max", "display_ssim.mean"});
+// The metrics whose noise floors are measured (the catalog's noise_floor); with `display`, a display
+// test's display figures too (issue 29), so its display tolerances get margins like the linear ones.
+std::vector<const MetricInfo*> floor_metrics(bool display) {
+    std::vector<const MetricInfo*> m;
+    for (const MetricInfo* k : judged_metrics(display))
+        if (k->noise_floor) m.push_back(k);
     return m;
+}
+std::vector<std::string> floor_metrics(const TestCase& tc) {
+    std::vector<std::string> keys;
+    for (const MetricInfo* k : floor_metrics(tc.display.has_value())) keys.emplace_back(k->key);
+    return keys;
 }
 const DisplaySpace* display_of(const TestCase& tc) { return tc.display ? &*tc.display : nullptr; }
 
@@ -60,8 +67,8 @@ json margins_of(const TestCase& tc, const std::map<std::string, double>& floor, 
     for (auto& [metric, bound] : tc.baseline_tolerances) {
         if (bound.max)
             margin(metric, *bound.max);
-        else if (bound.min)
-            margin(metric, 1.0 - *bound.min);
+        else if (bound.min) // a bound on a higher-is-better figure: its distance from a perfect score
+            margin(metric, floor_distance(iblcheck::metric(metric), *bound.min));
     }
     for (auto& [metric, band] : tc.reference_band) {
         if (!approved_accuracy.is_object() || !approved_accuracy.contains(metric)) continue;
@@ -80,19 +87,16 @@ json sensitivity(const TestCase& tc, Worker& w, const cv::Mat& base, int flip_th
         TestSpec p = tc.spec;
         p.options.set(key, value);
         json m = compare_images(base, w.renderer.render(p).image, flip_threads);
-        sens[key] = {{"value", value},
-                     {"flip.mean", m["flip"]["mean"]},
-                     {"flip.p99", m["flip"]["p99"]},
-                     {"flip.block_max", m["flip"]["block_max"]},
-                     {"ssim.mean", m["ssim"]["mean"]}};
+        sens[key] = {{"value", value}};
+        for (const MetricInfo* k : floor_metrics(false)) // the linear figures whose floors are measured
+            sens[key][k->key] = m[k->group][k->field];
     }
     return sens;
 }
 } // namespace
 
 double floor_of(const json& metrics, const std::string& metric) {
-    double v = metric_value(metrics, metric);
-    return metric.rfind("ssim", 0) == 0 || metric.rfind("display_ssim", 0) == 0 ? 1.0 - v : v;
+    return floor_distance(iblcheck::metric(metric), metric_value(metrics, metric));
 }
 
 StabilityOutcome run_stability(const TestCase& tc, Worker& w, const cv::Mat& base, const cv::Mat& reference,

@@ -23,8 +23,8 @@ struct StabilityOutcome {
 StabilityOutcome run_stability(const TestCase& tc, Worker& w, const cv::Mat& base, const cv::Mat& reference,
                                const nlohmann::json& approved_accuracy, int flip_threads);
 
-// The floor a tolerance is measured against: for FLIP metrics the metric of (base vs variant); for
-// SSIM its distance from 1. Exposed for tests.
+// The floor a tolerance is measured against (metrics/catalog.h's floor_distance): for FLIP metrics
+// the metric of (base vs variant); for SSIM its distance from 1. Exposed for tests.
 double floor_of(const nlohmann::json& metrics_base_vs_variant, const std::string& metric);
 
 } // namespace iblcheck

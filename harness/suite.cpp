@@ -15,6 +15,7 @@
 #include "harness/golden_store.h"
 #include "kernel/errors.h"
 #include "kernel/json_check.h"
+#include "metrics/catalog.h"
 #include "renderers/environments/environment.h"
 #include "renderers/option_table.h"
 #include "renderers/renderer.h"
@@ -27,9 +28,8 @@ namespace iblcheck {
 
 namespace {
 
-const std::set<std::string> kMetrics = {"flip.mean",         "flip.p99",          "flip.block_max",   "ssim.mean",
-                                        "psnr.db",           "display_flip.mean", "display_flip.p99", "display_flip.block_max",
-                                        "display_ssim.mean", "display_psnr.db"};
+// The keys tolerances and bands may name: the catalog's judged metrics.
+const std::set<std::string> kMetrics = judged_metric_keys();
 
 // The suite reader's checks: the shared ones (kernel/json_check.h) plus options and bounds.
 struct Ctx : JsonChecker {

@@ -4,7 +4,7 @@
 // (reference/<key>__frames=N.exr: the quadrature truth of every frame, full BRDF and exact pixel
 // footprint), both sequences scored against it too ("truth"; checks truth_flicker, truth_flip_mean,
 // truth_flip_ratio). Each configured bound is a Check (verdict.h); a truth check without the truth
-// golden is missing-golden.
+// golden cannot judge: an InputError naming the golden (exit 2, bisect 125).
 #pragma once
 #include <filesystem>
 #include <vector>

@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "kernel/errors.h"
+#include "metrics/catalog.h"
 
 using nlohmann::json;
 
@@ -23,32 +24,14 @@ std::string percent_change(double value, double approved) {
     return fmt::format("{:+.1f} %", 100.0 * (value - approved) / approved);
 }
 
-json optional_json(const std::optional<double>& v) { return v ? json(*v) : json(); }
 } // namespace
-
-std::string_view verdict_name(Verdict v) {
-    switch (v) {
-    case Verdict::pass: return "pass";
-    case Verdict::improved: return "improved";
-    case Verdict::fail: return "fail";
-    case Verdict::missing_golden: return "missing-golden";
-    case Verdict::error: return "error";
-    }
-    return "error";
-}
-
-Verdict parse_verdict(std::string_view name) {
-    for (Verdict v : {Verdict::pass, Verdict::improved, Verdict::fail, Verdict::missing_golden, Verdict::error})
-        if (verdict_name(v) == name) return v;
-    throw InputError(fmt::format("unknown verdict '{}'", name));
-}
 
 bool is_regression(Verdict v) { return v == Verdict::fail || v == Verdict::missing_golden; }
 
 bool higher_is_better(std::string_view metric) {
-    if (metric.rfind("accuracy.", 0) == 0) metric.remove_prefix(9);
-    if (metric.rfind("display_", 0) == 0) metric.remove_prefix(8); // the same figures in display space
-    return metric.rfind("ssim", 0) == 0 || metric.rfind("psnr", 0) == 0;
+    if (metric.rfind("accuracy.", 0) == 0) metric.remove_prefix(9); // the same figure against the truth
+    const MetricInfo* m = find_metric(metric);                      // costs, temporal: lower is better
+    return m && m->direction == Direction::higher_is_better;
 }
 
 Check judge_bound(const std::string& metric, double value, const Bound& bound) {
@@ -182,27 +165,61 @@ size_t choose_baseline(const std::vector<Comparison>& candidates) {
     return best;
 }
 
-json to_json(const Check& c) {
-    json j = {{"metric", c.metric},
-              {"value", std::isfinite(c.value) ? json(c.value) : json()},
-              {"min", optional_json(c.min)},
-              {"max", optional_json(c.max)},
-              {"status", verdict_name(c.status)}};
-    if (c.approved) j["approved"] = std::isfinite(*c.approved) ? json(*c.approved) : json();
-    if (!c.message.empty()) j["message"] = c.message;
-    return j;
+CostJudgement judge_costs(const json& cost, const json& approved_cost, double max_growth) {
+    CostJudgement out;
+    out.comparison.kind = "cost";
+    for (auto& [key, value] : cost.items()) {
+        if (!approved_cost.is_object() || !approved_cost.contains(key) || !approved_cost[key].is_number()) {
+            out.unapproved = key;
+            return out;
+        }
+        out.comparison.checks.push_back(
+            judge_cost("cost." + key, value.get<double>(), approved_cost[key].get<double>(), max_growth));
+    }
+    conclude(out.comparison);
+    return out;
 }
 
-json to_json(const Comparison& c) {
-    json j = {{"kind", c.kind}, {"golden", c.golden}, {"verdict", verdict_name(c.verdict)}};
-    if (c.kind == "baseline") j["label"] = c.label;
-    if (!c.metrics.is_null()) j["metrics"] = c.metrics;
-    j["checks"] = json::array();
-    for (const Check& k : c.checks) j["checks"].push_back(to_json(k));
-    if (!c.message.empty()) j["message"] = c.message;
-    if (!c.images.is_null()) j["images"] = c.images;
-    if (!c.worst_block.is_null()) j["worst_block"] = c.worst_block;
-    return j;
+Verdict stop_verdict(TestStop stop) { return stop == TestStop::non_finite_render ? Verdict::fail : Verdict::error; }
+
+Verdict stability_verdict(bool deterministic, bool flaky, bool fail_on_flaky) {
+    return !deterministic || (flaky && fail_on_flaky) ? Verdict::fail : Verdict::pass;
+}
+
+std::string test_message(const std::vector<std::string>& problems, Verdict verdict,
+                         const std::optional<std::string>& driver_mismatch) {
+    std::string msg;
+    for (const std::string& p : problems) msg += (msg.empty() ? "" : "; ") + p;
+    if (driver_mismatch && verdict != Verdict::pass) msg += (msg.empty() ? "" : "; ") + *driver_mismatch;
+    return msg;
+}
+
+void VerdictCounts::add(Verdict v) {
+    pass += v == Verdict::pass;
+    fail += v == Verdict::fail;
+    improved += v == Verdict::improved;
+    missing += v == Verdict::missing_golden;
+    error += v == Verdict::error;
+}
+
+int run_exit_code(const VerdictCounts& c) {
+    if (c.error) return kExitError;
+    if (c.fail || c.missing) return kExitRegression;
+    return kExitPass;
+}
+
+int repeat_exit_code(int exit_code, int verdicts_changed) {
+    return verdicts_changed && exit_code == kExitPass ? kExitRegression : exit_code;
+}
+
+int bisect_exit_code(const VerdictCounts& c, bool shader_compile_error) {
+    if (shader_compile_error || c.error) return kExitCannotTest;
+    if (c.fail) return kExitRegression;
+    return c.missing ? kExitCannotTest : kExitPass;
+}
+
+std::string_view bisect_verdict_name(int exit_code) {
+    return exit_code == kExitPass ? "good" : exit_code == kExitRegression ? "bad" : "skip (125)";
 }
 
 } // namespace iblcheck

@@ -1,6 +1,8 @@
 // Verdicts: what a test's numbers mean, decided in one place. The runner measures (render,
 // metrics, cost) and hands the numbers here; nothing here renders or reads files, so every rule is
-// unit-tested on plain numbers (tests/test_verdict.cpp).
+// unit-tested on plain numbers (tests/test_verdict.cpp): the tolerances, what stops a test, the
+// test's message, and the exit codes of run and bisect. The results they fill (Check, Comparison,
+// Verdict) are the typed results of results/results.h.
 //
 // One function per kind of comparison, one signature (metric, measured value, criterion) -> Check,
 // after VK-GL-CTS's tcuImageCompare: a typed status and a message that says where, why and by how
@@ -15,13 +17,10 @@
 
 #include <nlohmann/json.hpp>
 
+#include "results/results.h"
+
 namespace iblcheck {
 
-// Ordered by severity: overall_verdict() keeps the worst.
-enum class Verdict { pass, improved, fail, missing_golden, error };
-
-std::string_view verdict_name(Verdict v);     // "pass", "improved", "fail", "missing-golden", "error"
-Verdict parse_verdict(std::string_view name); // throws InputError on an unknown name
 // A regression for CI and bisect: fail or missing-golden (exit 1). error is "cannot test" (exit 2).
 bool is_regression(Verdict v);
 
@@ -34,16 +33,8 @@ struct Band {
     double below = 0.1, above = 0.1, abs = 0.0;
 };
 
-struct Check {
-    std::string metric; // "flip.mean", "accuracy.flip.mean", "cost.spirv_instructions_per_pixel"
-    double value = 0;
-    std::optional<double> min, max; // the interval the value had to lie in
-    std::optional<double> approved; // bands and costs: the approved figure the interval is built on
-    Verdict status = Verdict::pass; // pass, improved or fail
-    std::string message;            // empty on pass
-};
-
-// Larger is better for SSIM and PSNR; smaller for FLIP and costs.
+// As the metric catalog says (metrics/catalog.h, "accuracy." stripped): larger is better for SSIM
+// and PSNR; smaller for FLIP, and for what it does not list (costs, temporal figures).
 bool higher_is_better(std::string_view metric);
 
 // value within [min, max] passes; outside fails.
@@ -57,19 +48,6 @@ Check judge_cost(const std::string& metric, double value, double approved, doubl
 // The metrics JSON of one image comparison (the keys of `iblcheck compare --json`): "flip.mean" ->
 // metrics["flip"]["mean"]. A missing or null metric reads as NaN (and so fails its check).
 double metric_value(const nlohmann::json& metrics, const std::string& key);
-
-// One comparison of the render against one golden.
-struct Comparison {
-    std::string kind;       // "baseline" or "reference"
-    std::string golden;     // path relative to the golden root
-    std::string label;      // baseline@label, "" for the primary
-    nlohmann::json metrics; // compare_images() output; null when the sizes differ
-    std::vector<Check> checks;
-    Verdict verdict = Verdict::pass;
-    std::string message;        // the failing checks, joined
-    nlohmann::json images;      // report images (test/golden/heatmap), set by the runner
-    nlohmann::json worst_block; // {x, y, flip, sphere}: the worst 16x16 block, set by the runner
-};
 
 // Every tolerance of a baseline comparison. Sizes must match: a size mismatch is a failed "size"
 // check naming both sizes (the caller passes the sizes; metrics may then be null).
@@ -86,7 +64,45 @@ Verdict overall_verdict(const std::vector<Verdict>& verdicts);
 // closest (lowest FLIP mean) failing one is reported. Returns the index of the chosen comparison.
 size_t choose_baseline(const std::vector<Comparison>& candidates);
 
-nlohmann::json to_json(const Check& c);
-nlohmann::json to_json(const Comparison& c);
+// The render's cost per pixel (`cost`: {figure: n}) against the cost its baseline approved, as one
+// comparison of kind "cost" (a judge_cost check per figure). A figure the baseline does not approve
+// cannot be judged: `unapproved` names it, and the caller stops the test with an error naming the
+// sidecar (exit 2), never a silent pass.
+struct CostJudgement {
+    Comparison comparison;
+    std::string unapproved;
+};
+CostJudgement judge_costs(const nlohmann::json& cost, const nlohmann::json& approved_cost, double max_growth);
+
+// What stopped a test before its checks were done: NaN/Inf in the render (pixels or coverage) is the
+// shader's fault, a regression (fail); a shader that does not compile, or anything else (a bad
+// input, a full disk), leaves the test unjudged (error).
+enum class TestStop { non_finite_render, shader_compile_error, cannot_test };
+Verdict stop_verdict(TestStop stop);
+
+// Stability (harness/stability.h): a render that is not deterministic fails; a flaky one (a
+// tolerance under min_margin times its noise floor) fails only when the suite asks for it.
+Verdict stability_verdict(bool deterministic, bool flaky, bool fail_on_flaky);
+
+// The test's message: every problem, joined by "; "; the platform the baseline was blessed on too
+// (driver_mismatch) when the test did not pass, as a hint, never a verdict.
+std::string test_message(const std::vector<std::string>& problems, Verdict verdict,
+                         const std::optional<std::string>& driver_mismatch);
+
+// How many tests of a run got each verdict.
+struct VerdictCounts {
+    int pass = 0, fail = 0, improved = 0, missing = 0, error = 0;
+    void add(Verdict v);
+};
+// `iblcheck run`: any error is 2 (cannot test), else any fail or missing-golden 1, else 0.
+int run_exit_code(const VerdictCounts& counts);
+// --repeat N: a verdict that changed between the runs turns a pass (0) into a regression (1).
+int repeat_exit_code(int exit_code, int verdicts_changed);
+// `iblcheck bisect` (git bisect run): only a verdict on the commit is 0 (good) or 1 (bad). A test
+// that could not be judged (error, a shader that does not compile) or has no approved golden in
+// --goldens (a goldens folder from before the test existed) is 125: skip this commit.
+int bisect_exit_code(const VerdictCounts& counts, bool shader_compile_error);
+// "good", "bad" or "skip (125)".
+std::string_view bisect_verdict_name(int exit_code);
 
 } // namespace iblcheck

@@ -13,6 +13,7 @@
 
 #include "kernel/errors.h"
 #include "kernel/input_file.h"
+#include "metrics/catalog.h"
 #include "reports/report_writer.h"
 
 namespace iblcheck::report {
@@ -56,18 +57,23 @@ json history_entry(const json& results) {
             if (!t.is_object() || !t.contains("name") || !t["name"].is_string()) continue;
             json x = json::object();
             x["verdict"] = t.value("verdict", "");
+            // The mean HDR-FLIP against the truth, under the three names it has (metrics/catalog.h):
+            // the result's accuracy summary and the history ("flip_mean"), stability's noise floor
+            // ("accuracy.flip.mean"), the truth's sidecar ("mean_flip").
+            const MetricInfo& flip = metric("flip.mean");
             if (auto a = t.find("accuracy"); a != t.end() && a->is_object())
-                if (auto f = a->find("flip_mean"); f != a->end() && f->is_number()) x["flip_mean"] = *f;
+                if (auto f = a->find(flip.accuracy_name); f != a->end() && f->is_number()) x[flip.accuracy_name] = *f;
             for (const char* k : {"frame_ms", "precompute_ms"})
                 if (auto v = t.find(k); v != t.end() && v->is_number()) x[k] = *v;
             // The accuracy's noise floor (drift.h): measured by --stability, else the truth's own seed noise.
             if (auto st = t.find("stability"); st != t.end() && st->is_object())
                 if (auto nf = st->find("noise_floor"); nf != st->end() && nf->is_object())
-                    if (auto f = nf->find("accuracy.flip.mean"); f != nf->end() && f->is_number()) x["flip_noise"] = *f;
+                    if (auto f = nf->find("accuracy." + std::string(flip.key)); f != nf->end() && f->is_number())
+                        x["flip_noise"] = *f;
             if (!x.contains("flip_noise"))
                 if (auto a = t.find("accuracy"); a != t.end() && a->is_object())
                     if (auto nf = a->find("noise_floor"); nf != a->end() && nf->is_object())
-                        if (auto f = nf->find("mean_flip"); f != nf->end() && f->is_number()) x["flip_noise"] = *f;
+                        if (auto f = nf->find(flip.truth_noise_name); f != nf->end() && f->is_number()) x["flip_noise"] = *f;
             // The repeated timings' range (suite timing_repeats); frame_ms is their median.
             if (auto sm = t.find("frame_ms_samples"); sm != t.end() && sm->is_array() && !sm->empty()) {
                 double lo = INFINITY, hi = -INFINITY;

@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include "metrics/catalog.h"
 #include "reports/report_html.h"
 #include "reports/verdict_text.h"
 
@@ -173,14 +174,15 @@ void accuracy_html(std::string& o, const json& t) {
     auto out = std::back_inserter(o);
     const json& acc = sub(t, "accuracy");
     const json& ps = sub(t, "per_sphere");
-    if (!num(acc, "flip_mean") && !(ps.is_array() && !ps.empty())) return;
+    const MetricInfo& flip = metric("flip.mean"); // its names in the summary and in the truth's sidecar
+    if (!num(acc, flip.accuracy_name) && !(ps.is_array() && !ps.empty())) return;
     o += "<div><h4>Accuracy against the truth</h4>";
-    if (auto f = num(acc, "flip_mean"))
+    if (auto f = num(acc, flip.accuracy_name)) {
+        const auto noise = num(sub(acc, "noise_floor"), flip.truth_noise_name);
         fmt::format_to(out, "<div class=\"meta\">mean FLIP <b>{}</b>{}{}</div>", fmt_num(*f),
                        str(acc, "golden").empty() ? "" : " against <span class=\"mono\">" + e(str(acc, "golden")) + "</span>",
-                       num(sub(acc, "noise_floor"), "mean_flip")
-                           ? fmt::format(" (the truth's own seed noise: {})", fmt_num(*num(sub(acc, "noise_floor"), "mean_flip")))
-                           : "");
+                       noise ? fmt::format(" (the truth's own seed noise: {})", fmt_num(*noise)) : "");
+    }
     if (ps.is_array() && !ps.empty()) {
         std::map<double, std::map<int, std::vector<const json*>>> grid; // roughness -> metal? -> spheres
         for (const json& sp : ps)

@@ -1,6 +1,8 @@
 // Validation of the results JSON (schema iblcheck-results/1, results/RESULTS_FORMAT.md). Only the
-// keys the report needs are required; every other key is checked for its type when present, so a
-// harness bug is reported as "<file>: tests[3] (name): 'frame_ms' must be a number", not a crash.
+// keys the report needs are required; every other key it reads is checked for its type when
+// present, so a harness bug is reported as "<file>: tests[3] (name): 'frame_ms' must be a number",
+// not a crash. The keys and their types are the typed results' (results.h: fields()); here, what
+// lies inside them.
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -10,6 +12,7 @@
 #include "kernel/errors.h"
 #include "kernel/input_file.h"
 #include "kernel/json_check.h"
+#include "results/results.h"
 #include "results/results_file.h"
 
 namespace iblcheck::results {
@@ -61,14 +64,17 @@ const std::set<std::string>& verdicts() {
     return v;
 }
 
+// The keys of one results object the reader checks, each by the type fields() gives it: a
+// present key of another type (null is absent) fails, as does a required one that is missing.
+void check_fields(const Checker& c, const json& obj, const std::string& where, ResultsObject object) {
+    for (const Field& f : fields(object))
+        if (f.checked) c.member(obj, where, f.key, f.type, f.required);
+}
+
 // One entry of a test's "comparisons": its kind, metrics, checks, worst block and images.
 void check_comparison(const Checker& c, const json& cmp, const std::string& cw) {
     if (!cmp.is_object()) c.fail(cw, fmt::format("must be an object, not {}", cmp.type_name()));
-    c.string_(cmp, cw, "kind", true);
-    c.string_(cmp, cw, "golden");
-    c.string_(cmp, cw, "verdict");
-    c.string_(cmp, cw, "message");
-    c.string_(cmp, cw, "label");
+    check_fields(c, cmp, cw, ResultsObject::comparison);
     if (const json* m = c.object(cmp, cw, "metrics"))
         for (auto& [name, group] : m->items()) {
             if (!group.is_object() && !group.is_null())
@@ -79,12 +85,7 @@ void check_comparison(const Checker& c, const json& cmp, const std::string& cw) 
             const json& ck = (*checks)[k];
             const std::string kw = fmt::format("{}: checks[{}]", cw, k);
             if (!ck.is_object()) c.fail(kw, fmt::format("must be an object, not {}", ck.type_name()));
-            c.string_(ck, kw, "metric", true);
-            c.number(ck, kw, "value");
-            c.number(ck, kw, "min");
-            c.number(ck, kw, "max");
-            c.number(ck, kw, "approved");
-            c.string_(ck, kw, "status");
+            check_fields(c, ck, kw, ResultsObject::check);
         }
     if (const json* wb = c.object(cmp, cw, "worst_block")) {
         for (const char* k : {"x", "y", "flip"}) c.number(*wb, cw + ": worst_block", k);
@@ -157,12 +158,7 @@ void check_test(const Checker& c, const json& t, size_t i) {
     const std::string verdict = t["verdict"].get<std::string>();
     if (!verdicts().count(verdict))
         c.fail(where, fmt::format("verdict '{}' is not one of pass, fail, improved, missing-golden, error", verdict));
-    for (const char* k :
-         {"suite", "scene", "method", "env", "variant", "message", "bless_command", "driver_mismatch", "image", "image_exr"})
-        c.string_(t, where, k);
-    for (const char* k :
-         {"width", "height", "precompute_ms", "frame_ms", "texture_fetches_per_pixel", "texture_bytes", "texel_count"})
-        c.number(t, where, k);
+    check_fields(c, t, where, ResultsObject::test);
     c.number_map(t, where, "cost");
     if (const json* smp = c.array(t, where, "frame_ms_samples"))
         for (size_t k = 0; k < smp->size(); ++k)
@@ -196,15 +192,12 @@ void validate_results(const json& r, const std::string& source) {
     Checker c{source};
     if (!r.is_object()) c.fail("", fmt::format("results must be a JSON object, not {}", r.type_name()));
     const json& schema = c.require(r, "", "schema");
-    if (!schema.is_string() || schema.get<std::string>() != "iblcheck-results/1")
+    if (!schema.is_string() || schema.get<std::string>() != kResultsSchema)
         c.fail("", fmt::format("schema is {} but this report reads \"iblcheck-results/1\"", schema.dump()));
-    for (const char* k : {"suite", "command", "started", "commit"}) c.string_(r, "", k);
-    c.number(r, "", "total_s");
-    c.boolean(r, "", "dirty");
-    c.object(r, "", "driver"); // shown: its plain values (device, driver, driver_info, mesa, llvm, api)
-    c.number_map(r, "", "counts");
     const json* tests = c.array(r, "", "tests");
     if (!tests) c.fail("", "missing key 'tests' (an array)");
+    check_fields(c, r, "", ResultsObject::run); // driver: its plain values are shown
+    c.number_map(r, "", "counts");
     for (size_t i = 0; i < tests->size(); ++i) check_test(c, (*tests)[i], i);
 }
 

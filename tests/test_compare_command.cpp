@@ -16,6 +16,9 @@
 #include "cli/compare_command.h"
 #include "image_io/image_io.h"
 #include "kernel/errors.h"
+#include "metrics/catalog.h"
+#include "metrics/image_compare.h"
+#include "metrics/psnr.h"
 #include "tests/synthetic_image.h"
 #include "tests/test_support.h"
 
@@ -85,6 +88,37 @@ TEST_F(CompareCommand, HdrPairOnlyFlipAndHumanTable) {
     ASSERT_EQ(run(c), 0) << err_.str();
     EXPECT_NE(out_.str().find("HDR-FLIP exposures"), std::string::npos) << out_.str();
     EXPECT_NE(out_.str().find("SSIM"), std::string::npos);
+}
+
+// Issue 31: `compare` gave psnr.db on the linear radiance (a ci render against its truth: 9.41 dB),
+// `run` after the display transform (20.94 dB): one key, two quantities. Now `compare` makes the
+// runner's comparison (compare_images with the runner's arguments) and gives the same value for
+// every key the runner records; the radiance's PSNR has its own key, linear_psnr.db.
+TEST_F(CompareCommand, GivesTheRunnersValueForEveryKey) {
+    // Radiance above 1, as a render has (the linear and the display PSNR then differ most).
+    cv::Mat a = synthetic(48, 40, 11, 0.02f) * 4.0, b = synthetic(48, 40, 12, 0.1f) * 4.0;
+    write_exr(path("golden.exr"), a);
+    write_exr(path("render.exr"), b);
+    CompareArgs c = args(path("golden.exr"), path("render.exr"));
+    c.json = true;
+    ASSERT_EQ(run(c), 0) << err_.str();
+    const auto cmd = nlohmann::json::parse(out_.str());
+    // The runner's comparison of the same files (golden_comparisons.cpp's measure of a test without
+    // a display space).
+    const cv::Mat golden = read_image(path("golden.exr")).pixels, render = read_image(path("render.exr")).pixels;
+    const auto runner = compare_images(golden, render, 0);
+    int keys = 0;
+    for (const MetricInfo* k : judged_metrics(false)) {
+        ASSERT_TRUE(runner[k->group][k->field].is_number()) << k->key;
+        EXPECT_EQ(cmd[k->group][k->field], runner[k->group][k->field]) << k->key;
+        ++keys;
+    }
+    EXPECT_EQ(keys, 5); // flip.mean, flip.p99, flip.block_max, ssim.mean, psnr.db
+    // The radiance's PSNR under its own key, and another quantity than psnr.db.
+    const PsnrResult linear = compute_psnr(golden, render);
+    EXPECT_EQ(cmd["linear_psnr"]["db"].get<double>(), linear.db);
+    EXPECT_EQ(cmd["linear_psnr"]["relative_mse"].get<double>(), compute_relative_mse(golden, render));
+    EXPECT_GT(std::fabs(cmd["psnr"]["db"].get<double>() - linear.db), 1.0);
 }
 
 TEST_F(CompareCommand, MissingFile) {
@@ -187,7 +221,7 @@ TEST_F(CompareCommand, IdenticalImagesPerfectScores) {
     const auto j = nlohmann::json::parse(out_.str());
     EXPECT_EQ(j["flip"]["mean"].get<double>(), 0.0);
     EXPECT_DOUBLE_EQ(j["ssim"]["mean"].get<double>(), 1.0);
-    EXPECT_TRUE(j["psnr"]["db"].is_null()); // +inf
+    EXPECT_EQ(j["psnr"]["db"].get<double>(), kPsnrIdentical); // +inf, written as `run` writes it
 }
 
 TEST(ComparePairsList, ParsesLines) {
@@ -252,7 +286,7 @@ TEST_F(CompareCommand, PairsReportEveryFailureAndExit2) {
     EXPECT_EQ(lines[1]["error"], "pairs.txt: line 2: expected 2 paths (REF TEST), found 1");
     EXPECT_NE(lines[2]["error"].get<std::string>().find(path("small.png") + ": size 8x8 does not match"), std::string::npos)
         << lines[2];
-    EXPECT_TRUE(lines[3]["psnr"]["db"].is_null()); // identical: the good pair is still compared
+    EXPECT_EQ(lines[3]["psnr"]["db"].get<double>(), kPsnrIdentical); // identical: the good pair is still compared
     EXPECT_NE(err_.str().find("compared 1 pair(s), 3 could not be compared"), std::string::npos) << err_.str();
 }
 

@@ -9,12 +9,12 @@
 
 #include "harness/golden_comparisons.h"
 #include "harness/golden_store.h"
-#include "harness/image_compare.h"
 #include "harness/suite.h"
 #include "harness/verdict.h"
 #include "kernel/errors.h"
 #include "metrics/display_space.h"
 #include "metrics/display_transform.h"
+#include "metrics/image_compare.h"
 #include "reports/report_html.h"
 #include "tests/test_support.h"
 
@@ -329,9 +329,10 @@ TEST(DisplayScores, ADisplayTestsWorstBlockIsFoundOnTheDisplay) {
         rr.coverage.ids = cv::Mat(rr.image.size(), CV_32S, cv::Scalar(-1));
         const BaselineOutcome b = judge_against_baselines(tc, rr, store, Artefacts{}, 1);
         ASSERT_EQ(b.comparison.verdict, Verdict::fail) << tc.name;
-        EXPECT_EQ(b.comparison.worst_block["metric"], "display_flip");
-        EXPECT_EQ(b.comparison.worst_block["flip"], b.comparison.metrics["display_flip"]["block_max"]);
-        EXPECT_NE(b.comparison.worst_block["flip"], b.comparison.metrics["flip"]["block_max"]);
+        ASSERT_TRUE(b.comparison.worst_block.has_value());
+        EXPECT_EQ(b.comparison.worst_block->metric, "display_flip");
+        EXPECT_EQ(b.comparison.worst_block->flip, b.comparison.metrics["display_flip"]["block_max"].get<double>());
+        EXPECT_NE(b.comparison.worst_block->flip, b.comparison.metrics["flip"]["block_max"].get<double>());
         EXPECT_NE(b.comparison.message.find("with mean LDR-FLIP on the display"), std::string::npos) << b.comparison.message;
     }
 }

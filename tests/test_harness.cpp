@@ -1,7 +1,7 @@
 // The harness (issue 6): suite schema errors, shards, bless/missing-golden/improved/alternate
 // baselines on a private golden folder, JUnit, and the gate: a deliberate shader change makes the
 // `ci` suite fail on exactly the tests it affects, `iblcheck bisect` follows git bisect's contract.
-// Also the per-sphere breakdown of an error map by a render's sphere coverage (image_compare.h).
+// Also the per-sphere breakdown of an error map by a render's sphere coverage (sphere_errors.h).
 #include <gtest/gtest.h>
 
 #include <fmt/format.h>
@@ -15,9 +15,9 @@
 #include <sys/wait.h>
 
 #include "harness/golden_store.h"
-#include "harness/image_compare.h"
 #include "harness/run_console.h"
 #include "harness/runner.h"
+#include "harness/sphere_errors.h"
 #include "harness/suite.h"
 #include "kernel/errors.h"
 #include "renderers/environments/environment.h"

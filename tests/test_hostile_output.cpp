@@ -188,7 +188,7 @@ TEST(HostileOutput, AnImageThatCannotBeWrittenIsATestErrorNotAnAbort) {
     json r;
     fs::create_directories(dir / "goldens/baseline"); // an empty store: the test has no golden, so does not pass
     fs::create_directories(dir / "goldens/reference");
-    ASSERT_NO_THROW(r = run_test(tc, w, GoldenStore(dir / "goldens"), dir / "out", 0, 1, shader_error));
+    ASSERT_NO_THROW(r = to_json(run_test(tc, w, GoldenStore(dir / "goldens"), dir / "out", 0, 1, shader_error)));
     EXPECT_EQ(r["verdict"], "error");
     EXPECT_NE(r["message"].get<std::string>().find((dir / "out/images" / safe_file_name(tc.name) / "test.exr").string()),
               std::string::npos)

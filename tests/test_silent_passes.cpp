@@ -9,11 +9,11 @@
 
 #include "harness/bless.h"
 #include "harness/golden_store.h"
-#include "harness/image_compare.h"
 #include "harness/runner.h"
 #include "harness/suite.h"
 #include "image_io/image_io.h"
 #include "kernel/errors.h"
+#include "metrics/image_compare.h"
 #include "tests/furnace_store.h"
 #include "tests/test_support.h"
 
@@ -233,7 +233,7 @@ TEST(SilentPasses, ATemporalTruthCheckWithoutItsGoldenIsAnInputError) {
 }
 
 TEST(SilentPasses, AGoldenWithAHugeFinitePixelPassesABitIdenticalRender) {
-    // The runner's and bless's comparison (image_compare.h): SSIM was NaN for a golden with one pixel
+    // The runner's and bless's comparison (metrics/image_compare.h): SSIM was NaN for a golden with one pixel
     // at 1e20, so a bit-identical render failed it forever; against another render FLIP saw nothing.
     const Golden g = GoldenStore().baselines("mobile.roughness_sweep.studio.default")[0];
     cv::Mat hot = g.image.clone();

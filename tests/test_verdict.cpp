@@ -132,3 +132,76 @@ TEST(Verdict, JsonHasTheResultsFormatKeys) {
     EXPECT_EQ(jc["verdict"], "fail");
     EXPECT_TRUE(jc["checks"][0]["value"].is_number()); // the report's schema wants numbers
 }
+
+// The cost comparison: one judge_cost check per figure, the worst status, the messages joined; a
+// figure the baseline did not approve is named (the caller stops the test with an error), not passed.
+TEST(Verdict, CostsAreJudgedPerFigureAndAnUnapprovedFigureIsNamed) {
+    const json approved = {{"spirv_instructions_per_pixel", 1000.0}, {"texture_fetches_per_pixel", 10.0}};
+    CostJudgement ok =
+        judge_costs({{"spirv_instructions_per_pixel", 1300.0}, {"texture_fetches_per_pixel", 5.0}}, approved, 0.25);
+    EXPECT_TRUE(ok.unapproved.empty());
+    EXPECT_EQ(ok.comparison.kind, "cost");
+    ASSERT_EQ(ok.comparison.checks.size(), 2u);
+    EXPECT_EQ(ok.comparison.checks[0].metric, "cost.spirv_instructions_per_pixel");
+    EXPECT_EQ(ok.comparison.checks[0].status, Verdict::fail);
+    EXPECT_EQ(ok.comparison.checks[1].status, Verdict::improved);
+    EXPECT_EQ(ok.comparison.verdict, Verdict::fail);
+    EXPECT_EQ(ok.comparison.message, ok.comparison.checks[0].message + "; " + ok.comparison.checks[1].message);
+    EXPECT_EQ(judge_costs({{"texture_fetches_per_pixel", 10.0}}, approved, 0.25).comparison.verdict, Verdict::pass);
+    for (const json& without : {json::object(), json{{"texture_fetches_per_pixel", "10"}}, json(3.0)}) {
+        CostJudgement missing = judge_costs({{"texture_fetches_per_pixel", 10.0}}, without, 0.25);
+        EXPECT_EQ(missing.unapproved, "texture_fetches_per_pixel") << without;
+    }
+}
+
+// NaN/Inf in a render is the shader's fault (fail); anything else that stops a test is error.
+TEST(Verdict, WhatStopsATestIsAFailOnlyForANonFiniteRender) {
+    EXPECT_EQ(stop_verdict(TestStop::non_finite_render), Verdict::fail);
+    EXPECT_EQ(stop_verdict(TestStop::shader_compile_error), Verdict::error);
+    EXPECT_EQ(stop_verdict(TestStop::cannot_test), Verdict::error);
+}
+
+TEST(Verdict, StabilityFailsANonDeterministicRenderAndAFlakyOneOnlyWhenAsked) {
+    EXPECT_EQ(stability_verdict(true, false, true), Verdict::pass);
+    EXPECT_EQ(stability_verdict(false, false, false), Verdict::fail);
+    EXPECT_EQ(stability_verdict(true, true, false), Verdict::pass);
+    EXPECT_EQ(stability_verdict(true, true, true), Verdict::fail);
+}
+
+TEST(Verdict, TheTestMessageNamesThePlatformOnlyWhenTheTestDidNotPass) {
+    const std::string diff = "golden blessed on another platform: CPU class a -> b";
+    EXPECT_EQ(test_message({"baseline: x", "accuracy: y"}, Verdict::fail, diff), "baseline: x; accuracy: y; " + diff);
+    EXPECT_EQ(test_message({}, Verdict::improved, diff), diff);
+    EXPECT_EQ(test_message({}, Verdict::pass, diff), "");
+    EXPECT_EQ(test_message({"flaky: z"}, Verdict::pass, std::nullopt), "flaky: z");
+}
+
+// run: 2 on any error, else 1 on fail or missing-golden; --repeat: a changed verdict makes 0 a 1;
+// bisect: 0 good, 1 bad, 125 when a test could not be judged or has no golden.
+TEST(Verdict, ExitCodesOfRunRepeatAndBisect) {
+    auto counts = [](std::initializer_list<Verdict> vs) {
+        VerdictCounts c;
+        for (Verdict v : vs) c.add(v);
+        return c;
+    };
+    const VerdictCounts pass = counts({Verdict::pass, Verdict::improved}), fail = counts({Verdict::pass, Verdict::fail}),
+                        missing = counts({Verdict::missing_golden}), error = counts({Verdict::fail, Verdict::error});
+    EXPECT_EQ(pass.pass, 1);
+    EXPECT_EQ(pass.improved, 1);
+    EXPECT_EQ(run_exit_code(pass), kExitPass);
+    EXPECT_EQ(run_exit_code(fail), kExitRegression);
+    EXPECT_EQ(run_exit_code(missing), kExitRegression);
+    EXPECT_EQ(run_exit_code(error), kExitError);
+    EXPECT_EQ(repeat_exit_code(kExitPass, 0), kExitPass);
+    EXPECT_EQ(repeat_exit_code(kExitPass, 2), kExitRegression);
+    EXPECT_EQ(repeat_exit_code(kExitError, 2), kExitError);
+    EXPECT_EQ(bisect_exit_code(pass, false), kExitPass);
+    EXPECT_EQ(bisect_exit_code(fail, false), kExitRegression);
+    EXPECT_EQ(bisect_exit_code(missing, false), kExitCannotTest);
+    EXPECT_EQ(bisect_exit_code(error, false), kExitCannotTest);
+    EXPECT_EQ(bisect_exit_code(pass, true), kExitCannotTest);
+    EXPECT_EQ(bisect_exit_code(fail, true), kExitCannotTest);
+    EXPECT_EQ(bisect_verdict_name(kExitPass), "good");
+    EXPECT_EQ(bisect_verdict_name(kExitRegression), "bad");
+    EXPECT_EQ(bisect_verdict_name(kExitCannotTest), "skip (125)");
+}
