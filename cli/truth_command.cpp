@@ -24,6 +24,7 @@
 #include "kernel/output_files.h"
 #include "kernel/shell_quote.h"
 #include "renderers/environments/environment.h"
+#include "renderers/option_table.h"
 
 namespace iblcheck::cli {
 
@@ -64,7 +65,7 @@ struct TruthArgs {
     std::string scene = "roughness_sweep", env, env_name, size, goldens, out, integrator = "quadrature", compare, tiles, command;
     std::vector<std::string> sets;
     bool force = false;
-    int frames = 0, spp = kReferenceDefaultSpp, seed = 0;
+    int frames = 0, spp = option_int(OptionMap{}, "spp", "reference"), seed = option_int(OptionMap{}, "seed", "reference");
     bool spp_given = false, seed_given = false;
 };
 

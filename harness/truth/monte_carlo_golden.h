@@ -8,13 +8,14 @@
 
 #include <nlohmann/json.hpp>
 
+#include "renderers/option_table.h"
 #include "renderers/reference/monte_carlo/monte_carlo.h"
 
 namespace iblcheck::truth {
 
 struct MonteCarloGoldenRequest {
     TestSpec spec; // scene, env (loaded from spec.env), options (material, threads, ...)
-    int spp = kReferenceDefaultSpp;
+    int spp = option_int(OptionMap{}, "spp", "reference");
     int seed = 0;        // the golden's lighting seed; the noise floor's second render uses seed + 1
     std::string out_exr; // the golden; the sidecar is the same path with .json
     std::string command; // recorded as the regenerating command
