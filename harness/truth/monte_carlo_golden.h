@@ -11,7 +11,7 @@
 #include "renderers/option_table.h"
 #include "renderers/reference/monte_carlo/monte_carlo.h"
 
-namespace iblcheck::truth {
+namespace iblcheck::reference {
 
 struct MonteCarloGoldenRequest {
     TestSpec spec; // scene, env (loaded from spec.env), options (material, threads, ...)
@@ -34,4 +34,4 @@ MonteCarloGoldenWritten write_monte_carlo_golden(const MonteCarloGoldenRequest& 
 // one line per tile row ("mean FLIP/relative RMSE" per tile), then fully vs partially covered pixels.
 std::string noise_floor_by_tile(const MonteCarloGoldenWritten& golden, int tile_w, int tile_h);
 
-} // namespace iblcheck::truth
+} // namespace iblcheck::reference
