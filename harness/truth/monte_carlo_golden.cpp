@@ -10,7 +10,15 @@
 #include "harness/truth/truth_golden.h"
 #include "metrics/flip.h"
 
-namespace iblcheck::truth {
+namespace iblcheck::reference {
+
+// The golden writers' shared pieces (truth_golden.h): the same files, criterion and environment spelling as
+// the quadrature's goldens.
+using truth::kCriterionFlip;
+using truth::kCriterionRelativeRmse;
+using truth::portable_env_spec;
+using truth::utc_now;
+using truth::write_golden_files;
 
 namespace {
 // Issue 5's convergence criterion on the noise floor between the two seeds, stated with its verdict.
@@ -89,4 +97,4 @@ std::string noise_floor_by_tile(const MonteCarloGoldenWritten& g, int tile_w, in
     return s;
 }
 
-} // namespace iblcheck::truth
+} // namespace iblcheck::reference
