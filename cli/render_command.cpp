@@ -75,8 +75,9 @@ void register_list_command(CLI::App& app, int& exit_code) {
         for (auto& e : environment_catalog()) fmt::print("  {:<20} {}\n", e.spec, e.description);
         fmt::print("options (--set key=value; methods that read them):\n");
         for (auto& o : option_catalog())
-            fmt::print("  {:<22} default {:<10} values {:<34} [{}] {}\n", o.key, o.default_value, o.values, o.methods,
-                       o.description);
+            if (!o.internal)
+                fmt::print("  {:<22} default {:<10} values {:<34} [{}] {}\n", o.key, o.default_text(), o.values, o.methods,
+                           o.description);
         exit_code = kExitPass;
     });
 }

@@ -25,6 +25,7 @@
 #include "kernel/output_files.h"
 #include "kernel/shell_quote.h"
 #include "renderers/environments/environment.h"
+#include "renderers/option_table.h"
 
 namespace iblcheck::cli {
 
@@ -65,7 +66,7 @@ struct TruthArgs {
     std::string scene = "roughness_sweep", env, env_name, size, goldens, out, integrator = "quadrature", compare, tiles, command;
     std::vector<std::string> sets;
     bool force = false, print_name = false;
-    int frames = 0, spp = kReferenceDefaultSpp, seed = 0;
+    int frames = 0, spp = option_int(OptionMap{}, "spp", "reference"), seed = option_int(OptionMap{}, "seed", "reference");
     bool spp_given = false, seed_given = false;
 };
 
@@ -172,10 +173,10 @@ int run_quadrature(const truth::GoldenRequest& req, ProgressLine& line) {
 }
 
 int run_monte_carlo(const TruthArgs& a, const truth::GoldenRequest& req) {
-    truth::MonteCarloGoldenRequest mr;
+    reference::MonteCarloGoldenRequest mr;
     mr.spec = req.spec, mr.spp = a.spp, mr.seed = a.seed, mr.out_exr = req.out_exr, mr.command = req.command;
     fmt::print(stderr, "[truth] Monte Carlo, {} spp, seeds {} and {} (noise floor)...\n", a.spp, a.seed, a.seed + 1);
-    const truth::MonteCarloGoldenWritten g = truth::write_monte_carlo_golden(mr);
+    const reference::MonteCarloGoldenWritten g = reference::write_monte_carlo_golden(mr);
     const auto& nf = g.meta["noise_floor"];
     fmt::print("wrote {} and {} ({}x{}, {} spp, {:.1f} s)\n", req.out_exr, sidecar(req.out_exr), g.meta["width"].get<int>(),
                g.meta["height"].get<int>(), a.spp, g.meta["time_s"].get<double>());
@@ -183,7 +184,7 @@ int run_monte_carlo(const TruthArgs& a, const truth::GoldenRequest& req) {
                100 * nf["relative_rmse"].get<double>(), nf["mean_flip"].get<double>(), g.criterion_met ? "met" : "NOT met");
     if (!a.tiles.empty()) {
         const auto [w, h] = parse_tiles(a.tiles);
-        fmt::print("{}", truth::noise_floor_by_tile(g, w, h));
+        fmt::print("{}", reference::noise_floor_by_tile(g, w, h));
     }
     return g.criterion_met ? kExitPass : kExitRegression;
 }

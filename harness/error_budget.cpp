@@ -31,7 +31,7 @@ namespace {
 // The configuration's value of a step's option (the option table's default where not set).
 std::string config_value(const OptionMap& o, const std::string& key) {
     if (key == "ssaa") return std::to_string(ssaa_of(o));
-    if (key == "prefilter_samples") return std::to_string(o.get_int(key, 256));
+    if (key == "prefilter_samples") return std::to_string(option_int(o, key, "mobile"));
     return option_choice(o, key);
 }
 
@@ -68,7 +68,7 @@ BudgetPlan plan_budget(const std::string& scene, const std::string& env, const O
     OptionMap shared, truth_only, gpu;
     for (const auto& [k, v] : config.values()) {
         if (k == "ao") {
-            if (config.get_double("ao", 1) != 1)
+            if (option_double(config, "ao", "mobile") != 1)
                 throw UsageError("--set ao=" + v + ": the truth models no ambient occlusion (ao = 1 only)");
         } else if (is_scene_key(k) || k == "env_rotation") {
             shared.set(k, v);
@@ -102,7 +102,7 @@ BudgetPlan plan_budget(const std::string& scene, const std::string& env, const O
     plan.ladder.push_back({"mip_chain", "GPU converged: the prefiltered mip chain", converged});
     TestSpec walk = converged;
     for (const auto& [k, v] : steps(config, order)) {
-        const std::string from = converged.options.get_string(k, "");
+        const std::string from = converged.options.get_string(k).value_or("");
         walk.options.set(k, v);
         const std::string label = fmt::format("{} {} -> {}", k, from, v);
         plan.ladder.push_back({k, label, walk});

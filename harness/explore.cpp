@@ -19,20 +19,17 @@ std::string ExplorePoint::name() const { return options.values().empty() ? "defa
 
 namespace {
 
-// The value the renderer uses for `key` when the configuration does not set it.
+// The value the mobile renderer uses for `key` when the configuration does not set it (the option
+// table's, as text); a default the renderer computes or that is not a number is no value to start from.
 std::string default_value(const std::string& key) {
-    if (key == "ssaa") return std::to_string(ssaa_of(OptionMap{}));
-    if (key == "cube_size") return "128";
     const OptionInfo& info = option_info(key);
-    if (info.enumerated()) return info.default_value;
-    char* end = nullptr;
-    std::strtod(info.default_value.c_str(), &end);
-    if (end == info.default_value.c_str() || *end != '\0')
-        throw UsageError("--axis " + key + ": the option's default ('" + info.default_value + "') is not a value to start from");
-    return info.default_value;
+    const OptionValue& v = option_default(OptionMap{}, key, "mobile");
+    if (!info.enumerated() && !std::holds_alternative<int>(v) && !std::holds_alternative<double>(v))
+        throw UsageError("--axis " + key + ": the option's default ('" + info.default_text() + "') is not a value to start from");
+    return option_value_text(v);
 }
 
-std::string current_value(const OptionMap& o, const std::string& key) { return o.get_string(key, default_value(key)); }
+std::string current_value(const OptionMap& o, const std::string& key) { return o.get_string(key).value_or(default_value(key)); }
 
 // `o` with key = value, leaving the option unset where the value is its default (one name per point).
 OptionMap with(OptionMap o, const std::string& key, const std::string& value) {

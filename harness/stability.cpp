@@ -9,6 +9,7 @@
 #include "child_render.h"
 #include "metrics/catalog.h"
 #include "metrics/image_compare.h"
+#include "renderers/option_table.h"
 #include "verdict.h"
 
 using nlohmann::json;
@@ -119,7 +120,7 @@ StabilityOutcome run_stability(const TestCase& tc, Worker& w, const cv::Mat& bas
     if (monte_carlo(tc.spec))
         for (int s = 1; s < st.seeds; ++s) {
             TestSpec seeded = tc.spec;
-            seeded.options.set("seed", std::to_string(tc.spec.options.get_int("seed", 0) + s));
+            seeded.options.set("seed", std::to_string(option_int(tc.spec.options, "seed", tc.spec.method) + s));
             variants.emplace_back(fmt::format("seed {}", s), w.renderer.render(seeded).image);
         }
     json cpu = json::object();

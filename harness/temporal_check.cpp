@@ -57,7 +57,7 @@ TemporalOutcome run_temporal(const TestCase& tc, Worker& w, const GoldenStore& s
     truth_spec.scene = tc.spec.scene, truth_spec.env = tc.spec.env, truth_spec.env_name = tc.spec.env_name,
     truth_spec.width = tc.spec.width, truth_spec.height = tc.spec.height;
     for (const char* k : {"roughness", "metallic", "base_color", "env_rotation"})
-        if (tc.spec.options.has(k)) truth_spec.options.set(k, tc.spec.options.get_string(k, ""));
+        if (tc.spec.options.has(k)) truth_spec.options.set(k, *tc.spec.options.get_string(k));
     std::vector<cv::Mat> truth_linear;
     const std::optional<Golden> truth = store.reference_sequence(truth_spec, ts.frames, truth_linear);
     if (truth) {

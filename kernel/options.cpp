@@ -35,51 +35,54 @@ void OptionMap::set_from_string(const std::string& kv) {
     values_[kv.substr(0, eq)] = kv.substr(eq + 1);
 }
 
-std::string OptionMap::get_string(const std::string& key, const std::string& def) const {
+std::optional<std::string> OptionMap::get_string(const std::string& key) const {
     auto it = values_.find(key);
-    return it == values_.end() ? def : it->second;
+    if (it == values_.end()) return std::nullopt;
+    return it->second;
 }
 
-double OptionMap::get_double(const std::string& key, double def) const {
+std::optional<double> OptionMap::get_double(const std::string& key) const {
     auto it = values_.find(key);
-    return it == values_.end() ? def : parse_double(key, it->second);
+    if (it == values_.end()) return std::nullopt;
+    return parse_double(key, it->second);
 }
 
-int OptionMap::get_int(const std::string& key, int def) const {
+std::optional<int> OptionMap::get_int(const std::string& key) const {
     auto it = values_.find(key);
-    if (it == values_.end()) return def;
+    if (it == values_.end()) return std::nullopt;
     double v = parse_double(key, it->second);
     if (v != std::floor(v) || std::fabs(v) > 1e9)
         throw UsageError("option '" + key + "': '" + it->second + "' is not an integer");
     return static_cast<int>(v);
 }
 
-bool OptionMap::get_bool(const std::string& key, bool def) const {
+std::optional<bool> OptionMap::get_bool(const std::string& key) const {
     auto it = values_.find(key);
-    if (it == values_.end()) return def;
+    if (it == values_.end()) return std::nullopt;
     const std::string& s = it->second;
     if (s == "1" || s == "true" || s == "on" || s == "yes") return true;
     if (s == "0" || s == "false" || s == "off" || s == "no") return false;
     throw UsageError("option '" + key + "': '" + s + "' is not a boolean (on|off|true|false|1|0)");
 }
 
-Vec3f OptionMap::get_vec3(const std::string& key, Vec3f def) const {
+std::optional<Vec3f> OptionMap::get_vec3(const std::string& key) const {
     auto it = values_.find(key);
-    if (it == values_.end()) return def;
+    if (it == values_.end()) return std::nullopt;
     std::vector<double> parts;
     std::stringstream ss(it->second);
     std::string item;
     while (std::getline(ss, item, ',')) parts.push_back(parse_double(key, item));
-    if (parts.size() == 1) return {float(parts[0]), float(parts[0]), float(parts[0])};
-    if (parts.size() == 3) return {float(parts[0]), float(parts[1]), float(parts[2])};
+    if (parts.size() == 1) return Vec3f{float(parts[0]), float(parts[0]), float(parts[0])};
+    if (parts.size() == 3) return Vec3f{float(parts[0]), float(parts[1]), float(parts[2])};
     throw UsageError("option '" + key + "': '" + it->second + "' needs 1 or 3 comma-separated numbers");
 }
 
-std::string OptionMap::get_choice(const std::string& key, const std::string& def, const std::vector<std::string>& allowed) const {
-    std::string v = get_string(key, def);
+std::optional<std::string> OptionMap::get_choice(const std::string& key, const std::vector<std::string>& allowed) const {
+    auto v = get_string(key);
+    if (!v) return std::nullopt;
     for (const auto& a : allowed)
-        if (a == v) return v;
-    throw UsageError("option '" + key + "': unknown value '" + v + "'; valid: " + join(allowed));
+        if (a == *v) return v;
+    throw UsageError("option '" + key + "': unknown value '" + *v + "'; valid: " + join(allowed));
 }
 
 void OptionMap::check_known(const std::set<std::string>& known, const std::string& context) const {

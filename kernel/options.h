@@ -4,6 +4,7 @@
 // that names the key.
 #pragma once
 #include <map>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
@@ -23,13 +24,16 @@ class OptionMap {
     void erase(const std::string& key) { values_.erase(key); }
     bool has(const std::string& key) const { return values_.count(key) != 0; }
 
-    std::string get_string(const std::string& key, const std::string& def) const;
-    double get_double(const std::string& key, double def) const;
-    int get_int(const std::string& key, int def) const;
-    bool get_bool(const std::string& key, bool def) const;
-    Vec3f get_vec3(const std::string& key, Vec3f def) const; // "r,g,b" or a single value
+    // The value of `key` parsed, or nothing when it is not set; UsageError naming the key for a
+    // malformed value. No default here: an option's default lives in the option table
+    // (renderers/option_table.h, option_int and friends), once.
+    std::optional<std::string> get_string(const std::string& key) const;
+    std::optional<double> get_double(const std::string& key) const;
+    std::optional<int> get_int(const std::string& key) const;
+    std::optional<bool> get_bool(const std::string& key) const;
+    std::optional<Vec3f> get_vec3(const std::string& key) const; // "r,g,b" or a single value
     // A string that must be one of `allowed`; throws UsageError listing them otherwise.
-    std::string get_choice(const std::string& key, const std::string& def, const std::vector<std::string>& allowed) const;
+    std::optional<std::string> get_choice(const std::string& key, const std::vector<std::string>& allowed) const;
 
     // Throws UsageError naming every key not in `known` (and listing the known ones).
     void check_known(const std::set<std::string>& known, const std::string& context) const;

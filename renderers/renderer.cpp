@@ -59,7 +59,7 @@ void validate_spec(const TestSpec& spec) {
     if (!spec.shader.empty()) validate_contract_spec(spec);
     std::set<std::string> known;
     for (auto& o : option_catalog())
-        if (o.read_by(spec.method)) known.insert(o.key);
+        if (o.read_by(spec.method) && !o.internal) known.insert(o.key);
     spec.options.check_known(known, "method " + spec.method);
     // Enumerated values are checked here too, so a suite file with a misspelt variant fails when
     // it is loaded, not halfway through a run.

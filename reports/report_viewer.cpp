@@ -1,5 +1,5 @@
 // The image viewer of a test card (report_html.h). Its markup works without its script (the
-// PNGs); the script (report_script.h) swaps in canvases drawn from the float data once it has loaded.
+// PNGs); the script (assets/report.js) swaps in canvases drawn from the float data once it has loaded.
 #include <cmath>
 #include <iterator>
 

@@ -22,7 +22,6 @@
 #include "reports/nightly_findings.h"
 #include "reports/report_assets.h"
 #include "reports/report_html.h"
-#include "reports/report_script.h"
 #include "reports/verdict_text.h"
 
 namespace iblcheck::report {
@@ -150,7 +149,7 @@ void page_head(std::string& o, const std::string& suite, std::map<std::string, i
     title += c.empty() ? "no tests" : c;
     fmt::format_to(std::back_inserter(o),
                    "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<meta name=\"viewport\" "
-                   "content=\"width=device-width, initial-scale=1\">\n<title>{}</title>\n<style>{}</style>\n</head>\n"
+                   "content=\"width=device-width, initial-scale=1\">\n<title>{}</title>\n<style>\n{}</style>\n</head>\n"
                    "<body data-check=\"pending\">\n<main>\n",
                    e(title), assets::kCss);
 }
@@ -347,7 +346,7 @@ void page_end(std::string& o, const ImageStore& store, const DataStore& data) {
                    "<footer>Written by <code>iblcheck report</code> from results schema iblcheck-results/1. Rebuild "
                    "it with <code>iblcheck report RESULTS.json --out DIR [--history FILE]</code>. Static and offline: "
                    "open index.html from the file system; image data in data/ ({} files).</footer>\n</main>\n"
-                   "<script>{}</script>\n<script>{}</script>\n</body></html>\n",
+                   "<script>{}</script>\n<script>\n{}</script>\n</body></html>\n",
                    data.files(), js_config(), assets::kJs);
 }
 

@@ -34,19 +34,19 @@ TEST(ErrorBudget, DefaultConfigurationWalksTheStepsItUses) {
                                                         "diffuse", "storage"}));
     EXPECT_EQ(keys(p.isolated), (std::vector<std::string>{"ssaa", "prefilter_samples", "diffuse", "storage"}));
     EXPECT_EQ(p.truth.method, "reference");
-    EXPECT_EQ(p.ladder[0].spec.options.get_string("split_sum", ""), "exact");
+    EXPECT_EQ(p.ladder[0].spec.options.get_string("split_sum"), "exact");
     // The converged state, and the last rung is the configuration's values (the option table's defaults).
     const OptionMap& c = p.ladder[2].spec.options;
-    EXPECT_EQ(c.get_string("prefilter_samples", ""), "4096");
-    EXPECT_EQ(c.get_string("diffuse", ""), "irradiance_cube");
+    EXPECT_EQ(c.get_string("prefilter_samples"), "4096");
+    EXPECT_EQ(c.get_string("diffuse"), "irradiance_cube");
     const OptionMap& last = p.ladder.back().spec.options;
-    EXPECT_EQ(last.get_string("ssaa", ""), "2");
-    EXPECT_EQ(last.get_string("prefilter_samples", ""), "256");
-    EXPECT_EQ(last.get_string("diffuse", ""), "sh9");
-    EXPECT_EQ(last.get_string("storage", ""), "rgba16f");
+    EXPECT_EQ(last.get_string("ssaa"), "2");
+    EXPECT_EQ(last.get_string("prefilter_samples"), "256");
+    EXPECT_EQ(last.get_string("diffuse"), "sh9");
+    EXPECT_EQ(last.get_string("storage"), "rgba16f");
     // An isolated step changes only its own option from the converged state.
-    EXPECT_EQ(p.isolated[2].spec.options.get_string("diffuse", ""), "sh9");
-    EXPECT_EQ(p.isolated[2].spec.options.get_string("prefilter_samples", ""), "4096");
+    EXPECT_EQ(p.isolated[2].spec.options.get_string("diffuse"), "sh9");
+    EXPECT_EQ(p.isolated[2].spec.options.get_string("prefilter_samples"), "4096");
 }
 
 TEST(ErrorBudget, ConfigurationOptionsAddStepsAndHeldOptionsPassThrough) {
@@ -58,9 +58,9 @@ TEST(ErrorBudget, ConfigurationOptionsAddStepsAndHeldOptionsPassThrough) {
                                               {"truth_tolerance", "0.004"}}));
     EXPECT_EQ(keys(p.ladder), (std::vector<std::string>{"split_sum", "env_brdf_approx", "mip_chain", "ssaa", "diffuse", "storage",
                                                         "precision", "normalization"}));
-    EXPECT_EQ(p.ladder[2].spec.options.get_string("cube_size", ""), "64"); // held from the converged rung on
-    EXPECT_FALSE(p.ladder[2].spec.options.has("truth_tolerance"));         // a truth control: CPU rungs only
-    EXPECT_EQ(p.ladder[0].spec.options.get_string("truth_tolerance", ""), "0.004");
+    EXPECT_EQ(p.ladder[2].spec.options.get_string("cube_size"), "64"); // held from the converged rung on
+    EXPECT_FALSE(p.ladder[2].spec.options.has("truth_tolerance"));     // a truth control: CPU rungs only
+    EXPECT_EQ(p.ladder[0].spec.options.get_string("truth_tolerance"), "0.004");
 }
 
 TEST(ErrorBudget, OrderPutsTheNamedStepsFirst) {

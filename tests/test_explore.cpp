@@ -7,6 +7,7 @@
 
 #include "harness/explore.h"
 #include "kernel/errors.h"
+#include "renderers/option_table.h"
 #include "test_support.h"
 
 namespace iblcheck {
@@ -17,12 +18,12 @@ namespace {
 ExplorePoint synthetic(const OptionMap& o) {
     ExplorePoint p;
     p.flip = 0.30, p.ipp = 1000, p.fetches = 3, p.bytes = 1000;
-    const bool cube = o.get_string("diffuse", "sh9") == "irradiance_cube";
-    const std::string dom = o.get_string("dominant_dir", "off");
+    const bool cube = option_choice(o, "diffuse") == "irradiance_cube";
+    const std::string dom = option_choice(o, "dominant_dir");
     if (cube) p.flip -= 0.04, p.ipp -= 50, p.fetches += 1, p.bytes += 100;
     if (dom == "lagarde") p.flip += cube ? -0.08 : 0.01, p.ipp += 60;
     if (dom == "filament") p.flip -= 0.02, p.ipp += 300; // more accurate alone, but over the budget
-    if (o.get_string("storage", "rgba16f") == "rgbm8") p.flip += 0.001, p.bytes -= 500;
+    if (option_choice(o, "storage") == "rgbm8") p.flip += 0.001, p.bytes -= 500;
     return p;
 }
 

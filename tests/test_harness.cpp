@@ -127,7 +127,7 @@ TEST(Suite, TemporalReferenceIsSharedAndTakesReferenceOptions) {
     EXPECT_EQ(without_specular_aa(other.spec).options.canonical(), without_specular_aa(tc.spec).options.canonical());
     tc.spec.options.set("shading", "compute");
     tc.temporal.reference_options = OptionMap();
-    EXPECT_EQ(temporal_reference_spec(tc).options.get_int("ssaa", 0), 16); // compute's ssaa defaults to 2
+    EXPECT_EQ(temporal_reference_spec(tc).options.get_int("ssaa"), 16); // compute's ssaa defaults to 2
 }
 
 TEST(Suite, ShardsPartitionTheSuite) {
@@ -435,8 +435,7 @@ TEST(Temporal, BrokenSpecularAntiAliasingFailsTheGate) {
     Suite shipped = load_suite("temporal");
     const TestCase* claim = nullptr;
     for (auto& t : shipped.tests)
-        if (t.spec.scene == "bumpy_sphere" && t.spec.env == "sky_sun" &&
-            t.spec.options.get_string("specular_aa", "") == "toksvig")
+        if (t.spec.scene == "bumpy_sphere" && t.spec.env == "sky_sun" && t.spec.options.get_string("specular_aa") == "toksvig")
             claim = &t;
     ASSERT_NE(claim, nullptr);
     ASSERT_TRUE(claim->temporal.checks.count("flicker_ratio"));

@@ -35,7 +35,7 @@ TEST(OptionTable, EnumerationsListTheirDefaultFirst) {
         if (!o.enumerated()) continue;
         ++enumerations;
         ASSERT_FALSE(o.choices().empty()) << o.key;
-        EXPECT_EQ(o.choices().front(), o.default_value) << o.key;
+        EXPECT_EQ(o.choices().front(), option_value_text(o.defaults.value)) << o.key;
     }
     EXPECT_GE(enumerations, 9);
 }
@@ -89,7 +89,7 @@ TEST(OptionTable, SelectionsComeFromTheTable) {
     o.set("specular_aa", "rjump");
     auto s = shader_selections(o, "mobile");
     EXPECT_EQ(s.at("specular_aa"), "rjump");
-    EXPECT_EQ(s.at("storage"), option_info("storage").default_value);
+    EXPECT_EQ(s.at("storage"), option_value_text(option_info("storage").defaults.value));
     for (const auto& info : option_catalog()) {
         if (!info.glsl_define.empty() && info.read_by("mobile")) {
             EXPECT_EQ(s.count(info.key), 1u) << info.key;

@@ -57,3 +57,25 @@ TEST(ReportHeader, ShaderFilesThatChangedSinceTheBaselinesAreNamedByFile) {
     EXPECT_EQ(h.find("<th>shader tree</th>"), std::string::npos) << "the files say it, the tree hash adds nothing";
     fs::remove_all(dir);
 }
+
+// The page's style sheet and script are the files reports/assets/report.css and report.js, embedded at
+// build time byte for byte (issue 31: they were C++ raw strings in report_assets.h and report_script.h).
+TEST(ReportAssets, PageCarriesTheAssetFilesByteForByte) {
+    auto read = [](const fs::path& p) {
+        std::ifstream f(p, std::ios::binary);
+        return std::string((std::istreambuf_iterator<char>(f)), {});
+    };
+    const std::string css = read(fs::path(IBLCHECK_SOURCE_DIR) / "reports/assets/report.css");
+    const std::string js = read(fs::path(IBLCHECK_SOURCE_DIR) / "reports/assets/report.js");
+    ASSERT_GT(css.size(), 5000u);
+    ASSERT_GT(js.size(), 15000u);
+    const fs::path dir = testutil::temp_dir("assets");
+    testutil::CiRun run = testutil::make_ci_run(dir / "run", 2, 1);
+    report::write_report(run.results, run.dir, run.dir);
+    const std::string html = read(run.dir / "index.html");
+    EXPECT_NE(html.find("<style>\n" + css + "</style>\n</head>"), std::string::npos);
+    const std::string tail = "<script>\n" + js + "</script>\n</body></html>\n";
+    ASSERT_GE(html.size(), tail.size());
+    EXPECT_EQ(html.substr(html.size() - tail.size()), tail);
+    fs::remove_all(dir);
+}

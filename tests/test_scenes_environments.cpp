@@ -156,9 +156,9 @@ TEST(Options, NumbersBeyondAFloatAreRefused) {
     o.set("env_rotation", "1e39");
     o.set("roughness", "-4e38");
     o.set("ao", "3e38");
-    EXPECT_THROW(o.get_double("env_rotation", 0), UsageError); // was inf once cast to float
-    EXPECT_THROW(o.get_double("roughness", 0), UsageError);
-    EXPECT_EQ(o.get_double("ao", 0), 3e38);
+    EXPECT_THROW(o.get_double("env_rotation"), UsageError); // was inf once cast to float
+    EXPECT_THROW(o.get_double("roughness"), UsageError);
+    EXPECT_EQ(o.get_double("ao"), 3e38);
 }
 
 TEST(Environment, NegativesAreClampedAndCounted) {

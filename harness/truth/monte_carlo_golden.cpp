@@ -11,7 +11,13 @@
 #include "harness/truth/truth_golden.h"
 #include "metrics/flip.h"
 
-namespace iblcheck::truth {
+namespace iblcheck::reference {
+
+// The golden writers' shared pieces (truth_golden.h): the same criterion and environment spelling as the
+// quadrature's goldens (both write through GoldenStore::write_golden).
+using truth::kCriterionFlip;
+using truth::kCriterionRelativeRmse;
+using truth::portable_env_spec;
 
 namespace {
 // Issue 5's convergence criterion on the noise floor between the two seeds, stated with its verdict.
@@ -90,4 +96,4 @@ std::string noise_floor_by_tile(const MonteCarloGoldenWritten& g, int tile_w, in
     return s;
 }
 
-} // namespace iblcheck::truth
+} // namespace iblcheck::reference

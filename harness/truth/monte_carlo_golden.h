@@ -8,13 +8,14 @@
 
 #include <nlohmann/json.hpp>
 
+#include "renderers/option_table.h"
 #include "renderers/reference/monte_carlo/monte_carlo.h"
 
-namespace iblcheck::truth {
+namespace iblcheck::reference {
 
 struct MonteCarloGoldenRequest {
     TestSpec spec; // scene, env (loaded from spec.env), options (material, threads, ...)
-    int spp = kReferenceDefaultSpp;
+    int spp = option_int(OptionMap{}, "spp", "reference");
     int seed = 0;        // the golden's lighting seed; the noise floor's second render uses seed + 1
     std::string out_exr; // the golden; the sidecar is the same path with .json
     std::string command; // recorded as the regenerating command
@@ -33,4 +34,4 @@ MonteCarloGoldenWritten write_monte_carlo_golden(const MonteCarloGoldenRequest& 
 // one line per tile row ("mean FLIP/relative RMSE" per tile), then fully vs partially covered pixels.
 std::string noise_floor_by_tile(const MonteCarloGoldenWritten& golden, int tile_w, int tile_h);
 
-} // namespace iblcheck::truth
+} // namespace iblcheck::reference

@@ -19,6 +19,7 @@
 #include "image_io/image_io.h"
 #include "kernel/errors.h"
 #include "metrics/flip.h"
+#include "renderers/option_table.h"
 #include "renderers/reference/quadrature/lobe_quadrature.h"
 #include "renderers/reference/quadrature/truth_renderer.h"
 
@@ -184,7 +185,7 @@ Scene keep_spheres(const Scene& scene, const std::vector<std::string>& only) {
 std::vector<TruthImage> render_levels(const Args& args, const Scene& scene, std::vector<TruthAccuracy>& levels,
                                       std::vector<double>& cpu) {
     Environment env = load_environment(args.env_spec);
-    if (args.opts.has("env_rotation")) env.rotation_deg = float(args.opts.get_double("env_rotation", 0.0));
+    if (args.opts.has("env_rotation")) env.rotation_deg = float(option_double(args.opts, "env_rotation", "reference"));
     const EnvPyramid pyramid(env);
     const std::string key = env.content_hash + "@" + std::to_string(env.rotation_deg);
     std::vector<TruthImage> img;

@@ -175,7 +175,7 @@ Environment load_environment(const std::string& spec) {
     if (spec.rfind("constant:", 0) == 0) {
         OptionMap o;
         o.set("constant", spec.substr(9));
-        Vec3f c = o.get_vec3("constant", {});
+        Vec3f c = *o.get_vec3("constant"); // set just above
         if (c.x < 0 || c.y < 0 || c.z < 0) throw UsageError("environment '" + spec + "': radiance must be >= 0");
         Environment env;
         env.spec = spec;

@@ -33,24 +33,24 @@ struct MobileOptions {
 MobileOptions read_mobile_options(const OptionMap& o) {
     MobileOptions m;
     PrecomputeSettings& ps = m.ps;
-    ps.cube_size = uint32_t(o.get_int("cube_size", 128));
-    ps.mips = o.has("mips") ? uint32_t(std::max(0, o.get_int("mips", 0))) : 0; // 0: the full chain
+    ps.cube_size = uint32_t(option_int(o, "cube_size", "mobile"));
+    ps.mips = uint32_t(std::max(0, o.get_int("mips").value_or(0))); // 0: the full chain (the table's computed default)
     if (o.has("mips") && ps.mips < 1) throw UsageError("option 'mips' must be at least 1 (leave it out for the full chain)");
-    ps.prefilter_samples = uint32_t(o.get_int("prefilter_samples", 256));
+    ps.prefilter_samples = uint32_t(option_int(o, "prefilter_samples", "mobile"));
     m.variant = shader_selections(o, "mobile");
     ps.mip_mapping = m.variant.at("mip_mapping");
     ps.storage = m.variant.at("storage");
     ps.astc_block = option_choice(o, "astc_block");
     ps.env_layout = m.variant.at("env_layout");
     // rgbm_range: "peak" (default: the source's peak, ibl_precompute.cpp) or a fixed range.
-    if (o.get_string("rgbm_range", "peak") != "peak") {
-        ps.rgbm_range = float(o.get_double("rgbm_range", 0.0));
+    if (option_string(o, "rgbm_range", "mobile") != "peak") {
+        ps.rgbm_range = float(o.get_double("rgbm_range").value()); // set: not the default
         if (!(ps.rgbm_range > 0)) throw UsageError("option 'rgbm_range' must be 'peak' or a number > 0");
     }
     ps.lut = m.variant.at("env_brdf") == "lut";
-    ps.lut_size = uint32_t(o.get_int("lut_size", 64));
+    ps.lut_size = uint32_t(option_int(o, "lut_size", "mobile"));
     ps.irradiance_cube = m.variant.at("diffuse") == "irradiance_cube";
-    ps.env_rotation_deg = float(o.get_double("env_rotation", 0.0));
+    ps.env_rotation_deg = float(option_double(o, "env_rotation", "mobile"));
     if (ps.prefilter_samples < 1 || ps.prefilter_samples > 65536)
         throw UsageError("option 'prefilter_samples' must be in 1..65536");
     m.fp16 = option_choice(o, "fp16");
@@ -77,18 +77,18 @@ vk::Defines shading_defines(const MobileOptions& m, const IblResources& ibl, con
 // ssaa: rays per pixel (compute) or the supersampling factor (fragment, default 1: a phone
 // renders at its resolution and relies on MSAA at silhouettes).
 ShadePush shade_push(const OptionMap& o, int width, int height, const PrecomputeSettings& ps, const IblResources& ibl) {
-    std::string indirect = o.get_string("indirect_irradiance", "sh9");
+    std::string indirect = option_string(o, "indirect_irradiance", "mobile");
     ShadePush pc{uint32_t(width),
                  uint32_t(height),
                  uint32_t(ssaa_of(o)),
                  float(cubemap_max_mip(ps.cube_size)),
                  float(ibl.levels - 1),
-                 float(o.get_double("mix_begin_roughness", 0.1)),
-                 float(o.get_double("mix_end_roughness", 0.3)),
-                 float(o.get_double("mix_largest_weight", 10000.0)),
-                 indirect == "sh9" ? -1.0f : float(o.get_double("indirect_irradiance", 0)),
-                 float(o.get_double("specular_aa_variance", 0.25)),
-                 float(o.get_double("specular_aa_threshold", 0.18)),
+                 float(option_double(o, "mix_begin_roughness", "mobile")),
+                 float(option_double(o, "mix_end_roughness", "mobile")),
+                 float(option_double(o, "mix_largest_weight", "mobile")),
+                 indirect == "sh9" ? -1.0f : float(o.get_double("indirect_irradiance").value()),
+                 float(option_double(o, "specular_aa_variance", "mobile")),
+                 float(option_double(o, "specular_aa_threshold", "mobile")),
                  ps.env_rotation_deg};
     if (pc.ssaa < 1 || pc.ssaa > 16) throw UsageError("option 'ssaa' must be in 1..16");
     if (pc.mix_end <= pc.mix_begin) throw UsageError("option 'mix_end_roughness' must exceed 'mix_begin_roughness'");

@@ -1,11 +1,12 @@
 // The reference method: the quadrature truth by default, the Monte Carlo integrator on request (reference.h).
 #include "renderers/reference/reference.h"
 
+#include "renderers/option_table.h"
+
 namespace iblcheck {
 
 bool uses_quadrature(const TestSpec& spec) {
-    return spec.options.get_choice("integrator", spec.options.has("spp") ? "monte_carlo" : "quadrature",
-                                   {"quadrature", "monte_carlo"}) == "quadrature";
+    return option_choice(spec.options, "integrator") == "quadrature"; // the table: monte_carlo once spp is set
 }
 
 RenderResult render_reference(const TestSpec& spec) {

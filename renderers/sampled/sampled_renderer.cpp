@@ -15,9 +15,9 @@ namespace iblcheck {
 
 PrecomputeSettings sampled_precompute_settings(const TestSpec& spec) {
     PrecomputeSettings ps;
-    ps.cube_size = uint32_t(spec.options.get_int("cube_size", 256));
+    ps.cube_size = uint32_t(option_int(spec.options, "cube_size", "sampled"));
     ps.prefiltered = false;
-    ps.env_rotation_deg = float(spec.options.get_double("env_rotation", 0.0));
+    ps.env_rotation_deg = float(option_double(spec.options, "env_rotation", "sampled"));
     return ps;
 }
 
@@ -27,7 +27,7 @@ RenderResult render_sampled(GpuSession& gpu, const Environment& env, const TestS
     Scene scene = scene_for(spec, width, height);
 
     const PrecomputeSettings ps = sampled_precompute_settings(spec);
-    int samples = o.get_int("samples", 64);
+    int samples = option_int(o, "samples", "sampled");
     if (samples < 1 || samples > 65536) throw UsageError("option 'samples' must be in 1..65536");
 
     RenderResult result;
@@ -45,13 +45,13 @@ RenderResult render_sampled(GpuSession& gpu, const Environment& env, const TestS
     vk::Buffer out = ctx.create_buffer(VkDeviceSize(width) * height * 16);
     SampledPush pc{uint32_t(width),
                    uint32_t(height),
-                   uint32_t(o.get_int("ssaa", 2)),
+                   uint32_t(option_int(o, "ssaa", "sampled")),
                    uint32_t(samples),
                    ps.cube_size,
-                   uint32_t(o.get_int("seed", 0)),
+                   uint32_t(option_int(o, "seed", "sampled")),
                    float(ibl.full_mips - 1),
-                   float(o.get_double("min_lod", 0.0)),
-                   float(o.get_double("diffuse_roughness", 0.9))};
+                   float(option_double(o, "min_lod", "sampled")),
+                   float(option_double(o, "diffuse_roughness", "sampled"))};
     if (pc.ssaa < 1 || pc.ssaa > 16) throw UsageError("option 'ssaa' must be in 1..16");
 
     // Bindings 3 and 4 are unused by this shader; the layout keeps the mobile numbering.

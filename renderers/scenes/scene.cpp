@@ -1,15 +1,17 @@
 // Built-in analytic scenes (see scene.h for the camera convention).
 //
-// Material defaults for the scenes that read the material options (`sphere`, `grazing`): those of
-// Material in scene.h — roughness 0.5, metallic 0, base_color 1,1,1 (a white dielectric: Lambert
-// with albedo 1 plus the F0 = 0.04 specular lobe). The multi-sphere scenes fix their own materials
-// (that is what they are for); see the catalog descriptions.
+// Material defaults for the scenes that read the material options: the option table's, per scene
+// (`sphere`, `grazing`: roughness 0.5, metallic 0, base_color 1,1,1, a white dielectric: Lambert with
+// albedo 1 plus the F0 = 0.04 specular lobe; `bumpy_sphere`, `sphere_field`: a smooth metal). The
+// multi-sphere scenes fix their own materials (that is what they are for); see the catalog descriptions.
 #include "renderers/scenes/scene.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+
+#include "renderers/option_table.h"
 
 namespace iblcheck {
 
@@ -21,17 +23,19 @@ struct SceneDef {
     Scene (*build)(const OptionMap&);
 };
 
-Material material_from_options(const OptionMap& o) {
+// The material options as `scene` reads them (the option table holds each scene's defaults). A value
+// outside [0, 1] was set (every default is inside), so its text is there to quote.
+Material material_from_options(const OptionMap& o, const char* scene) {
     Material m;
-    m.roughness = float(o.get_double("roughness", m.roughness));
-    m.metallic = float(o.get_double("metallic", m.metallic));
-    m.base_color = o.get_vec3("base_color", m.base_color);
+    m.roughness = float(option_double(o, "roughness", scene));
+    m.metallic = float(option_double(o, "metallic", scene));
+    m.base_color = option_vec3(o, "base_color", scene);
     if (m.roughness < 0 || m.roughness > 1)
-        throw UsageError("option 'roughness': " + o.get_string("roughness", "") + " is outside [0, 1]");
+        throw UsageError("option 'roughness': " + o.get_string("roughness").value() + " is outside [0, 1]");
     if (m.metallic < 0 || m.metallic > 1)
-        throw UsageError("option 'metallic': " + o.get_string("metallic", "") + " is outside [0, 1]");
+        throw UsageError("option 'metallic': " + o.get_string("metallic").value() + " is outside [0, 1]");
     for (float c : {m.base_color.x, m.base_color.y, m.base_color.z})
-        if (c < 0 || c > 1) throw UsageError("option 'base_color': " + o.get_string("base_color", "") + " is outside [0, 1]");
+        if (c < 0 || c > 1) throw UsageError("option 'base_color': " + o.get_string("base_color").value() + " is outside [0, 1]");
     return m;
 }
 
@@ -41,7 +45,8 @@ std::string fmt_r(float r) {
     return buf;
 }
 
-Scene build_sphere(const OptionMap& o) {
+// One radius-1 sphere of the material options' values for `reader` (sphere, bumpy_sphere).
+Scene one_sphere(const OptionMap& o, const char* reader) {
     Scene s;
     s.name = "sphere";
     s.width = s.height = 128;
@@ -49,11 +54,13 @@ Scene build_sphere(const OptionMap& o) {
     Sphere sp;
     sp.center = {0, 0, 0};
     sp.radius = 1;
-    sp.material = material_from_options(o);
+    sp.material = material_from_options(o, reader);
     s.spheres.push_back(sp);
     s.labels.push_back("sphere r=" + fmt_r(sp.material.roughness));
     return s;
 }
+
+Scene build_sphere(const OptionMap& o) { return one_sphere(o, "sphere"); }
 
 Scene build_roughness_sweep(const OptionMap& o) {
     Scene s;
@@ -110,31 +117,24 @@ Scene build_grazing(const OptionMap& o) {
     s.camera.target = {0.9f, 0, 0};
     s.camera.half_height = 0.16f;
     Sphere sp;
-    sp.material = material_from_options(o);
+    sp.material = material_from_options(o, "grazing");
     s.spheres.push_back(sp);
     s.labels.push_back("grazing r=" + fmt_r(sp.material.roughness));
     return s;
 }
 
 // Animated normal detail for the temporal suite: the bumps (renderers/shaders/scene.glsl,
-// bump_normal) move by kBumpPhasePerFrame radians each frame, a fixed time step.
-constexpr float kBumpAmplitude = 0.0008f; // tilts the normal by up to ~0.16 rad
-constexpr float kBumpFrequency = 200.0f;  // ≈ 1.8 px wavelength at 128 px: sub-pixel detail that sparkles
+// bump_normal) move by kBumpPhasePerFrame radians each frame, a fixed time step. Their amplitude and
+// frequency are options (defaults in the option table).
 constexpr float kBumpPhasePerFrame = 0.9f;
 
 Scene build_bumpy_sphere(const OptionMap& o) {
-    Scene s = build_sphere([&] {
-        OptionMap m;
-        m.set("roughness", o.get_string("roughness", "0.05"));
-        m.set("metallic", o.get_string("metallic", "1"));
-        m.set("base_color", o.get_string("base_color", "0.95,0.93,0.88"));
-        return m;
-    }());
+    Scene s = one_sphere(o, "bumpy_sphere");
     s.name = "bumpy_sphere";
     Sphere& sp = s.spheres[0];
-    sp.bump_amplitude = float(o.get_double("bump_amplitude", kBumpAmplitude));
-    sp.bump_frequency = float(o.get_double("bump_frequency", kBumpFrequency));
-    sp.bump_phase = kBumpPhasePerFrame * float(o.get_int("frame", 0));
+    sp.bump_amplitude = float(option_double(o, "bump_amplitude", "bumpy_sphere"));
+    sp.bump_frequency = float(option_double(o, "bump_frequency", "bumpy_sphere"));
+    sp.bump_phase = kBumpPhasePerFrame * float(option_int(o, "frame", "bumpy_sphere"));
     s.labels[0] = "bumpy r=" + fmt_r(sp.material.roughness);
     return s;
 }
@@ -166,12 +166,12 @@ Scene build_sphere_field(const OptionMap& o) {
     s.width = s.height = 128;
     s.camera.half_height = 1.0f;
     Material m;
-    m.roughness = float(o.get_double("roughness", 0.05));
-    m.metallic = float(o.get_double("metallic", 1.0));
-    m.base_color = o.get_vec3("base_color", {0.95f, 0.93f, 0.88f});
+    m.roughness = float(option_double(o, "roughness", "sphere_field"));
+    m.metallic = float(option_double(o, "metallic", "sphere_field"));
+    m.base_color = option_vec3(o, "base_color", "sphere_field");
     if (m.roughness < 0 || m.roughness > 1)
-        throw UsageError("option 'roughness': " + o.get_string("roughness", "") + " is outside [0, 1]");
-    const float frame = float(o.get_int("frame", 0));
+        throw UsageError("option 'roughness': " + o.get_string("roughness").value() + " is outside [0, 1]");
+    const float frame = float(option_int(o, "frame", "sphere_field"));
     const float dx = std::cos(kFieldDriftDeg * 3.14159265f / 180.0f), dy = std::sin(kFieldDriftDeg * 3.14159265f / 180.0f);
     for (int j = 0; j < kFieldGrid; ++j)
         for (int i = 0; i < kFieldGrid; ++i) {
@@ -247,15 +247,15 @@ namespace {
 // Material AO (option ao) on every sphere of any scene.
 void apply_ao(Scene& s, const OptionMap& o) {
     if (!o.has("ao")) return;
-    float ao = float(o.get_double("ao", 1.0));
-    if (!(ao >= 0 && ao <= 1)) throw UsageError("option 'ao': " + o.get_string("ao", "") + " is outside [0, 1]");
+    float ao = float(option_double(o, "ao", s.name));
+    if (!(ao >= 0 && ao <= 1)) throw UsageError("option 'ao': " + o.get_string("ao").value() + " is outside [0, 1]");
     for (Sphere& sp : s.spheres) sp.material.ao = ao;
 }
 
 void apply_perturbations(Scene& s, const OptionMap& o) {
-    float bias = float(o.get_double("roughness_bias", 0.0));
+    float bias = float(option_double(o, "roughness_bias", s.name));
     for (Sphere& sp : s.spheres) sp.material.roughness = std::clamp(sp.material.roughness + bias, 0.0f, 1.0f);
-    Vec3f shift = o.get_vec3("camera_shift", {0, 0, 0}); // pixels: "x,y,0" or one value for x and y
+    Vec3f shift = option_vec3(o, "camera_shift", s.name); // pixels: "x,y,0" or one value for x and y
     if (shift.x == 0 && shift.y == 0) return;
     // Pixel size in world units at the scene's default size (orthographic: 2·half_height/height).
     Camera& c = s.camera;

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "renderers/option_table.h"
 #include "renderers/reference/monte_carlo/monte_carlo.h"
 
 namespace iblcheck {
@@ -35,7 +36,7 @@ NoiseFloor measure_noise_floor(const TestSpec& spec_in, int spp) {
     TestSpec spec = spec_in;
     NoiseFloor nf;
     nf.spp = spp;
-    nf.seed_a = spec.options.get_int("seed", 0);
+    nf.seed_a = option_int(spec.options, "seed", "reference");
     nf.seed_b = nf.seed_a + 1;
     Environment env = load_environment(spec.env);
     spec.options.set("spp", std::to_string(spp));

@@ -14,6 +14,7 @@
 #include <fmt/format.h>
 
 #include "kernel/parallel_for.h"
+#include "renderers/option_table.h"
 #include "renderers/reference/monte_carlo/mc_adaptive.h"
 #include "renderers/reference/monte_carlo/mc_pixel.h"
 
@@ -44,19 +45,19 @@ struct McOptions {
 
 McOptions read_options(const OptionMap& o) {
     McOptions m;
-    m.spp = o.get_int("spp", kReferenceDefaultSpp);
-    m.seed = o.get_int("seed", 0);
-    m.pattern = o.get_int("pixel_pattern", 0);
-    m.adaptive = o.get_int("adaptive", 1) != 0;
-    m.adaptive_cap = o.get_int("adaptive_cap", 16);
-    m.silhouette_boost = o.get_int("silhouette_boost", 16);
-    m.positions = std::clamp(o.get_int("positions", std::max(1, m.spp / 4)), 1, std::max(1, m.spp));
-    m.threads = o.get_int("threads", 0);
-    m.lobes = o.get_choice("lobes", "all", {"all", "diffuse", "specular"});
-    m.mis = o.get_choice("mis", "power", {"power", "balance"});
-    m.env_sampling = o.get_choice("env_sampling", "window", {"window", "global"});
-    m.env_window = o.get_choice("env_window", "hemisphere", {"hemisphere", "lobe"});
-    m.mis_compensation = o.get_double("mis_compensation", 0.0);
+    m.spp = option_int(o, "spp", "reference");
+    m.seed = option_int(o, "seed", "reference");
+    m.pattern = option_int(o, "pixel_pattern", "reference");
+    m.adaptive = option_int(o, "adaptive", "reference") != 0;
+    m.adaptive_cap = option_int(o, "adaptive_cap", "reference");
+    m.silhouette_boost = option_int(o, "silhouette_boost", "reference");
+    m.positions = std::clamp(o.get_int("positions").value_or(std::max(1, m.spp / 4)), 1, std::max(1, m.spp)); // the table: spp/4
+    m.threads = option_int(o, "threads", "reference");
+    m.lobes = option_choice(o, "lobes");
+    m.mis = option_choice(o, "mis");
+    m.env_sampling = option_choice(o, "env_sampling");
+    m.env_window = option_choice(o, "env_window");
+    m.mis_compensation = option_double(o, "mis_compensation", "reference");
     if (m.mis_compensation < 0) throw UsageError("option 'mis_compensation': must be >= 0");
     if (m.spp < 1) throw UsageError("option 'spp': must be >= 1");
     if (m.threads < 0) throw UsageError("option 'threads': must be >= 0");
@@ -195,7 +196,7 @@ ReferenceRender render_reference_full(const TestSpec& spec, const Environment* e
     const McLobes lobes = opt.lobes == "diffuse" ? McLobes::diffuse : opt.lobes == "specular" ? McLobes::specular : McLobes::all;
 
     Environment env = env_in ? *env_in : load_environment(spec.env);
-    if (spec.options.has("env_rotation")) env.rotation_deg = float(spec.options.get_double("env_rotation", 0.0));
+    if (spec.options.has("env_rotation")) env.rotation_deg = float(option_double(spec.options, "env_rotation", "reference"));
     EnvDistribution dist(env, opt.mis_compensation);
     cv::Mat equirect = env.equirect.isContinuous() ? env.equirect : env.equirect.clone();
     EnvImage img(equirect);

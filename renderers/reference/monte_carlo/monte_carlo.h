@@ -96,8 +96,6 @@
 
 namespace iblcheck {
 
-inline constexpr int kReferenceDefaultSpp = 256;
-
 // Renders spec with the Monte Carlo integrator (the environment loaded from spec.env unless given), and
 // the per-pixel coverage (fraction of sub-samples that hit a sphere, CV_32FC1).
 struct ReferenceRender {

@@ -13,6 +13,7 @@
 
 #include "kernel/errors.h"
 #include "kernel/parallel_for.h"
+#include "renderers/option_table.h"
 #include "renderers/reference/quadrature/footprint.h"
 #include "renderers/reference/quadrature/lobe_quadrature.h"
 #include "renderers/reference/quadrature/normal_table.h"
@@ -254,9 +255,9 @@ TruthRender render_truth(const TestSpec& spec, const Environment& env_in, const 
     const Scene scene = build_scene(spec.scene, spec.options);
     const OptionMap& o = spec.options;
     const int W = spec.width > 0 ? spec.width : scene.width, H = spec.height > 0 ? spec.height : scene.height;
-    const std::string lobes_s = o.get_choice("lobes", "all", {"all", "diffuse", "specular"});
+    const std::string lobes_s = option_choice(o, "lobes");
     const Lobes lobes = lobes_s == "diffuse" ? Lobes::diffuse : lobes_s == "specular" ? Lobes::specular : Lobes::all;
-    int threads = o.get_int("threads", 0);
+    int threads = option_int(o, "threads", "reference");
     if (threads < 0) throw UsageError("option 'threads': must be >= 0");
     threads = resolve_threads(threads);
     // Near-mirror lobes on smooth spheres: the outgoing radiance follows the environment's texel-scale
@@ -274,11 +275,11 @@ TruthRender render_truth(const TestSpec& spec, const Environment& env_in, const 
                                          scene.spheres[i].material.roughness, L.alpha, kNearMirrorAlpha));
     }
     TruthAccuracy acc;
-    acc.pixel_tolerance = o.get_double("truth_tolerance", acc.pixel_tolerance);
+    acc.pixel_tolerance = option_double(o, "truth_tolerance", "reference");
     if (!(acc.pixel_tolerance > 0)) throw UsageError("option 'truth_tolerance': must be > 0");
     acc.env_tolerance = acc.pixel_tolerance / 4;
     Environment env = env_in;
-    if (o.has("env_rotation")) env.rotation_deg = float(o.get_double("env_rotation", 0.0));
+    if (o.has("env_rotation")) env.rotation_deg = float(option_double(o, "env_rotation", "reference"));
     const EnvPyramid pyramid(env);
     TruthRender r;
     // Progress: the coarse level costs about half of the finer one (studio sweep: 46 s and 93 s of CPU).
@@ -287,7 +288,7 @@ TruthRender render_truth(const TestSpec& spec, const Environment& env_in, const 
         return [&progress, lo, hi](double f) { progress(lo + (hi - lo) * f); };
     };
     const std::string env_key = env.content_hash + "@" + std::to_string(env.rotation_deg);
-    const std::string split_s = o.get_choice("split_sum", "off", {"off", "exact", "env_brdf_approx"});
+    const std::string split_s = option_choice(o, "split_sum");
     if (split_s != "off") {
         r.coarse = render_truth_level(scene, W, H, pyramid, env_key, lobes, acc, threads, progress,
                                       split_s == "exact" ? SplitSum::exact : SplitSum::env_brdf_approx);

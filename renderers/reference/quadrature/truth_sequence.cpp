@@ -6,6 +6,7 @@
 
 #include "kernel/errors.h"
 #include "kernel/parallel_for.h"
+#include "renderers/option_table.h"
 
 namespace iblcheck::truth {
 
@@ -19,11 +20,11 @@ TruthSequence render_truth_sequence(const TestSpec& spec, const Environment& env
     TruthSequence out;
     out.accuracy = TruthAccuracy::temporal();
     out.bound_frames = bound_frames;
-    int threads = spec.options.get_int("threads", 0);
+    int threads = option_int(spec.options, "threads", "reference");
     if (threads < 0) throw UsageError("option 'threads': must be >= 0");
     out.threads = resolve_threads(threads);
     Environment env = env_in;
-    if (spec.options.has("env_rotation")) env.rotation_deg = float(spec.options.get_double("env_rotation", 0.0));
+    if (spec.options.has("env_rotation")) env.rotation_deg = float(option_double(spec.options, "env_rotation", "reference"));
     const EnvPyramid pyramid(env);
     const std::string env_key = env.content_hash + "@" + std::to_string(env.rotation_deg);
     // Progress in units of a frame at the sequence's level; a finer frame counts 3 (measured: its table

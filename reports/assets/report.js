@@ -1,22 +1,3 @@
-// The report's inline JavaScript (plain ES5-style script, no library, nothing fetched: the page
-// opens offline from file://). The writer puts `window.IBLCHECK_CFG = {aces: [6 coefficients],
-// magma: [768 values 0..255]}` before it, taken from the C++ the harness itself uses (the display
-// transform's tone curve and FLIP's colour map), so exposure 0 and scale 0-1 match the PNGs.
-//
-// - tabs (tests, charts, history, table) from the URL hash; the name/verdict filter;
-// - passing tests' tiles open their folded card; comparisons inside a card switch by buttons;
-// - the image viewer: data/<key>.js scripts (float_data.h) decoded to floats; exposure slider with
-//   auto exposure; test/golden switch (and blink); zoom with nearest-neighbour pixels; a magnifier
-//   on the worst 16x16 block that follows the pointer (click pins it); the FLIP heatmap on a chosen
-//   scale with its colour bar and the exceedance mask; the sphere and values under the pointer;
-// - the load check tests/test_report.cpp reads back from <body>: images, data scripts, viewers.
-// buildViewer() is ~110 lines on purpose: one closure that holds a viewer's state (exposure, zoom, mask,
-// the pinned block) and the handlers that read and redraw it; split, the state would travel in arguments.
-#pragma once
-
-namespace iblcheck::report::assets {
-
-inline constexpr const char* kJs = R"JS(
 (function(){
   'use strict';
   function $(s,r){return (r||document).querySelector(s);}
@@ -448,6 +429,3 @@ inline constexpr const char* kJs = R"JS(
   });
   window.iblcheckStats=stats;
 })();
-)JS";
-
-} // namespace iblcheck::report::assets
