@@ -208,7 +208,7 @@ bool same_pixels(const fs::path& exr, const cv::Mat& image) {
 
 void GoldenStore::write_golden(const fs::path& exr, const cv::Mat& image, const json& provenance) {
     std::error_code ec;
-    fs::create_directories(exr.parent_path(), ec);
+    if (exr.has_parent_path()) fs::create_directories(exr.parent_path(), ec); // `truth --out g.exr`: the current folder
     if (ec) throw InputError(exr.parent_path().string() + ": cannot create the golden folder: " + ec.message());
     // Bit-identical pixels keep their file (a deterministic truth regenerated unchanged): the sidecar alone.
     if (same_pixels(exr, image)) return write_sidecar(exr, provenance);

@@ -105,3 +105,13 @@ TEST_F(AtomicFile, TheGoldenStoreKeepsAnEXRWithTheSamePixels) {
     for (const auto& e : fs::directory_iterator(dir_ / "reference")) in_reference.insert(e.path().filename().string());
     EXPECT_EQ(in_reference, (std::set<std::string>{"g.exr", "g.json"}));
 }
+
+// A golden named without a folder (`iblcheck truth --out g.exr`) lands in the current folder (the store's
+// writer refused it, "cannot create the golden folder", once the truth wrote through it).
+TEST_F(AtomicFile, AGoldenWithoutAFolderIsWrittenInTheCurrentOne) {
+    const fs::path was = fs::current_path();
+    fs::current_path(dir_);
+    EXPECT_NO_THROW(GoldenStore::write_golden("g.exr", cv::Mat(2, 2, CV_32FC3, cv::Scalar(1, 1, 1)), {{"n", 1}}));
+    fs::current_path(was);
+    EXPECT_EQ(names(), (std::set<std::string>{"g.exr", "g.json"}));
+}
