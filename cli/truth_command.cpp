@@ -7,6 +7,7 @@
 //                               floor against a second render with seed K + 1 (monte_carlo_golden.h);
 //                               --tiles WxH prints that noise floor per tile
 //   --compare OLD.exr           prints the mean FLIP and relative RMSE between the new golden and OLD
+//   --print-name                prints the golden's name (harness/golden_store.h's reference_key) and exits
 // Nothing is overwritten without --force. Exit 0: written, criterion met; 1: written, criterion NOT met.
 #include <fmt/core.h>
 #include <unistd.h>
@@ -64,7 +65,7 @@ class ProgressLine {
 struct TruthArgs {
     std::string scene = "roughness_sweep", env, env_name, size, goldens, out, integrator = "quadrature", compare, tiles, command;
     std::vector<std::string> sets;
-    bool force = false;
+    bool force = false, print_name = false;
     int frames = 0, spp = option_int(OptionMap{}, "spp", "reference"), seed = option_int(OptionMap{}, "seed", "reference");
     bool spp_given = false, seed_given = false;
 };
@@ -202,6 +203,10 @@ int run_truth(const TruthArgs& a) {
     if (req.spec.options.has("split_sum")) // a rung of `iblcheck explain`, not a truth: never a golden
         throw UsageError(
             "--set split_sum: the split sum's rungs are approximations, not a truth; `iblcheck explain` renders them");
+    if (a.print_name) { // the regeneration script's names: the golden store's, never a copy of its rule
+        fmt::print("{}\n", a.frames > 0 ? reference_sequence_key(req.spec, a.frames) : reference_key(req.spec));
+        return kExitPass;
+    }
     // The golden store's key: the environment by its stable name (environment_label), never its folder.
     req.out_exr = golden_path(a, req.spec);
     req.command = recorded_command(a, truth::portable_env_spec(req.spec));
@@ -256,6 +261,9 @@ void register_truth_command(CLI::App& app, int& exit_code) {
     cmd->add_option("--command", a.command,
                     "The regenerating command recorded in the sidecar (default: this iblcheck truth command)");
     cmd->add_flag("--force", a.force, "Overwrite existing output files");
+    cmd->add_flag("--print-name", a.print_name,
+                  "Print the golden's name, the key of reference/<name>.exr that a suite test with this scene, "
+                  "environment, size, material (and --frames) reads, and exit: nothing is rendered or written");
     cmd->callback([&exit_code, cmd] {
         a.spp_given = cmd->count("--spp") > 0;
         a.seed_given = cmd->count("--seed") > 0;

@@ -1,13 +1,8 @@
 #include "artefacts.h"
 
-#include <unistd.h>
-
-#include <fmt/core.h>
-
-#include <thread>
-
 #include "golden_store.h"
 #include "image_io/image_io.h"
+#include "kernel/atomic_file.h"
 #include "kernel/profile.h"
 #include "metrics/display_transform.h"
 #include "sphere_errors.h"
@@ -38,10 +33,7 @@ std::string Artefacts::shared_exr(const std::string& golden_rel, const cv::Mat& 
     const std::string file = safe_file_name(golden_rel);
     if (!fs::exists(shared / file)) { // two workers (or processes) may both write it: same pixels, atomic rename
         fs::create_directories(shared);
-        const fs::path tmp =
-            shared / (file + fmt::format(".tmp{}-{}.exr", ::getpid(), std::hash<std::thread::id>{}(std::this_thread::get_id())));
-        write_exr_half(tmp.string(), linear);
-        fs::rename(tmp, shared / file);
+        write_file_atomically(shared / file, [&](const fs::path& tmp) { write_exr_half(tmp.string(), linear); });
     }
     return "images/_goldens/" + file;
 }

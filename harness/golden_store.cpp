@@ -3,14 +3,15 @@
 #include <array>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <ctime>
 #include <fstream>
 #include <set>
 #include <sstream>
-#include <unistd.h>
 
 #include "image_io/image_formats.h"
 #include "image_io/image_io.h"
+#include "kernel/atomic_file.h"
 #include "kernel/errors.h"
 #include "kernel/input_file.h"
 #include "kernel/profile.h"
@@ -90,6 +91,10 @@ std::string reference_key(const TestSpec& spec) {
     return key;
 }
 
+std::string reference_sequence_key(const TestSpec& spec, int frames) {
+    return reference_key(spec) + "__frames=" + std::to_string(frames);
+}
+
 std::string truth_command(const TestSpec& spec, const GoldenStore& store) {
     std::string c = program_name() + " truth --scene " + shell_arg(spec.scene) + " --env " + shell_arg(spec.env);
     if (!spec.env_name.empty()) c += " --env-name " + shell_arg(spec.env_name);
@@ -160,7 +165,7 @@ std::vector<Golden> GoldenStore::baselines(const std::string& test_name) const {
 }
 
 fs::path GoldenStore::reference_sequence_path(const TestSpec& spec, int frames) const {
-    return root_ / "reference" / (reference_key(spec) + "__frames=" + std::to_string(frames) + ".exr");
+    return root_ / "reference" / (reference_sequence_key(spec, frames) + ".exr");
 }
 
 std::optional<Golden> GoldenStore::reference_sequence(const TestSpec& spec, int frames, std::vector<cv::Mat>& out) const {
@@ -182,43 +187,36 @@ std::optional<Golden> GoldenStore::reference(const TestSpec& spec) const {
     return load_golden(p, "");
 }
 
+void GoldenStore::write_sidecar(const fs::path& exr, const json& provenance) {
+    write_file_atomically(fs::path(exr).replace_extension(".json"), provenance.dump(2) + "\n");
+}
+
 namespace {
-// Writes `text` to `file` through a temporary file renamed into place.
-void write_atomically(const fs::path& file, const std::string& text) {
-    fs::path tmp = file;
-    tmp += ".tmp" + std::to_string(::getpid());
-    {
-        std::ofstream f(tmp);
-        f << text;
-        if (!f) throw InputError(tmp.string() + ": cannot write");
-    }
+// Whether the golden `exr` holds exactly `image`'s pixels, bit for bit (false when absent or unreadable).
+bool same_pixels(const fs::path& exr, const cv::Mat& image) {
     std::error_code ec;
-    fs::rename(tmp, file, ec);
-    if (ec) {
-        fs::remove(tmp, ec);
-        throw InputError(file.string() + ": cannot write: " + ec.message());
+    if (!fs::exists(exr, ec)) return false;
+    try {
+        const cv::Mat old = read_image(exr.string()).pixels;
+        return old.size() == image.size() && old.type() == image.type() && old.isContinuous() && image.isContinuous() &&
+               std::memcmp(old.data, image.data, image.total() * image.elemSize()) == 0;
+    } catch (const Error&) {
+        return false; // unreadable: replaced
     }
 }
 } // namespace
 
-void GoldenStore::write_sidecar(const fs::path& exr, const json& provenance) {
-    write_atomically(fs::path(exr).replace_extension(".json"), provenance.dump(2) + "\n");
-}
-
 void GoldenStore::write_golden(const fs::path& exr, const cv::Mat& image, const json& provenance) {
     std::error_code ec;
-    fs::create_directories(exr.parent_path(), ec);
+    if (exr.has_parent_path()) fs::create_directories(exr.parent_path(), ec); // `truth --out g.exr`: the current folder
     if (ec) throw InputError(exr.parent_path().string() + ": cannot create the golden folder: " + ec.message());
-    fs::path tmp_exr = exr;
-    tmp_exr += ".tmp" + std::to_string(::getpid()) + ".exr";
-    write_exr(tmp_exr.string(), image);
-    // The sidecar first: a reader that sees the new image always finds its provenance beside it.
-    write_sidecar(exr, provenance);
-    fs::rename(tmp_exr, exr, ec);
-    if (ec) {
-        fs::remove(tmp_exr, ec);
-        throw InputError(exr.string() + ": cannot write: " + ec.message());
-    }
+    // Bit-identical pixels keep their file (a deterministic truth regenerated unchanged): the sidecar alone.
+    if (same_pixels(exr, image)) return write_sidecar(exr, provenance);
+    write_file_atomically(exr, [&](const fs::path& tmp) {
+        write_exr(tmp.string(), image);
+        // The sidecar before the image is renamed in: a reader that sees the new image finds its provenance.
+        write_sidecar(exr, provenance);
+    });
 }
 
 std::string project_commit(bool* dirty) {

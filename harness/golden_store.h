@@ -4,9 +4,11 @@
 //   baseline/<test>.exr + .json   the approved output of a tested configuration; alternates
 //                                  baseline/<test>@<label>.exr are further approved outputs (a known
 //                                  platform difference is approved, not hidden by a wider tolerance)
-// Every golden has a JSON sidecar of provenance. Only `iblcheck bless` (and the reference
-// regeneration script) writes goldens, atomically: image and sidecar go to temporary files that are
-// renamed into place, so a reader never sees a half-written golden.
+// Every golden has a JSON sidecar of provenance. GoldenStore::write_golden is the one writer of goldens
+// (`iblcheck bless`, and `iblcheck truth`, which the reference regeneration script runs), atomically:
+// image and sidecar go to temporary files that are renamed into place, so a reader never sees a
+// half-written golden. reference_key is the one place reference goldens are named (the script asks
+// `iblcheck truth --print-name`).
 #pragma once
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -49,8 +51,9 @@ class GoldenStore {
     std::optional<Golden> reference_sequence(const TestSpec& spec, int frames, std::vector<cv::Mat>& out) const;
     std::filesystem::path reference_sequence_path(const TestSpec& spec, int frames) const;
 
-    // Atomically writes image + sidecar (each through a temporary file renamed into place).
-    // Throws InputError naming the path when it cannot.
+    // Atomically writes image + sidecar (each through a temporary file renamed into place, the sidecar
+    // first), creating the folder. An EXR whose pixels are bit-identical to `image` is kept (only the
+    // sidecar is rewritten). Throws InputError naming the path when it cannot.
     static void write_golden(const std::filesystem::path& exr, const cv::Mat& image, const nlohmann::json& provenance);
     // Atomically rewrites the sidecar of `exr` only (the pixels are unchanged).
     static void write_sidecar(const std::filesystem::path& exr, const nlohmann::json& provenance);
@@ -66,6 +69,8 @@ class GoldenStore {
 // (roughness, metallic, base_color), a non-default size and env_rotation are appended, since they
 // change the true image.
 std::string reference_key(const TestSpec& spec);
+// The temporal truth of `frames` frames: reference_key(spec) + "__frames=N".
+std::string reference_sequence_key(const TestSpec& spec, int frames);
 // The command that renders the truth `spec` asks for into `store` under reference_key(spec): what a
 // test whose truth is missing prints (iblcheck truth ... --env FILE [--env-name N] [--size WxH]
 // [--set k=v] [--goldens ROOT]).

@@ -13,6 +13,7 @@
 #include <fstream>
 #include <string>
 
+#include "kernel/atomic_file.h"
 #include "kernel/errors.h"
 
 namespace fs = std::filesystem;
@@ -115,18 +116,7 @@ RunFolder::~RunFolder() {
 }
 
 void write_json_atomically(const fs::path& file, const nlohmann::json& j) {
-    fs::path tmp = file;
-    tmp += ".tmp" + std::to_string(::getpid());
-    std::ofstream f(tmp);
-    f << j.dump(1) << "\n";
-    f.close(); // a full disk shows at the last write, on close
-    std::error_code ec;
-    if (!f) {
-        fs::remove(tmp, ec);
-        throw InputError(file.string() + ": cannot write results JSON (" + std::strerror(errno) + ")");
-    }
-    fs::rename(tmp, file, ec);
-    if (ec) throw InputError(file.string() + ": cannot write results JSON: " + ec.message());
+    write_file_atomically(file, j.dump(1) + "\n", "results JSON");
 }
 
 } // namespace iblcheck

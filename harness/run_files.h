@@ -23,7 +23,7 @@ class RunFolder {
     // Where the run writes: the partial folder.
     const std::filesystem::path& dir() const { return partial_; }
     // Swaps the complete run in as --out (the earlier run, if any, is removed). Throws InputError
-    // naming --out when it cannot.
+    // naming --out when it cannot. (Folders, exchanged: not kernel/atomic_file.h, which writes a file.)
     void commit();
 
   private:

@@ -7,11 +7,12 @@
 #include <atomic>
 #include <chrono>
 #include <map>
+#include <memory>
 #include <mutex>
-#include <thread>
 
 #include "kernel/errors.h"
 #include "kernel/output_files.h"
+#include "kernel/parallel_for.h"
 #include "kernel/profile.h"
 #include "one_test.h"
 #include "provenance.h"
@@ -37,50 +38,39 @@ struct PoolOutcome {
     bool shader_error = false;
 };
 
-// The tests on `jobs` worker threads, each with its own renderer, taking the next batch of tests as
-// it finishes one; a line per test as it finishes unless quiet. Results stay in suite order.
+// The tests on `jobs` worker threads (at most one a batch), each with its own renderer, taking the next
+// batch of tests as it finishes one; a line per test as it finishes unless quiet. Results stay in suite order.
 PoolOutcome run_tests(const std::vector<TestCase>& tests, const RunOptions& o, const fs::path& out_dir, const GoldenStore& store,
                       int jobs, int timing_repeats) {
     const int flip_threads = jobs > 1 ? 1 : 0;
     std::vector<TestResult> results(tests.size());
     const std::vector<std::vector<size_t>> batches = precompute_batches(tests);
-    std::atomic<size_t> next{0};
     std::atomic<int> done{0};
     std::atomic<bool> shader_error{false};
-    std::mutex print_mutex, driver_mutex;
-    json driver;
+    std::mutex print_mutex;
     const bool interactive = isatty(STDOUT_FILENO);
     ConsoleBudget budget;
-    std::exception_ptr failure; // what stopped a worker (no device), rethrown after the join
-    auto work = [&] {
-        try {
-            Worker w(o.device);
-            for (size_t b; (b = next++) < batches.size();)
-                for (size_t i : batches[b]) {
-                    bool se = false;
-                    TestCase tc = tests[i];
-                    if (o.stability) tc.stability.enabled = true;
-                    results[i] = run_test(tc, w, store, out_dir, flip_threads, timing_repeats, se);
-                    if (se) shader_error = true;
-                    int n = ++done;
-                    if (!o.quiet) {
-                        std::lock_guard lock(print_mutex);
-                        print_test_line(to_json(results[i]), n, tests.size(), interactive, budget);
-                    }
+    // A worker's state is its GPU session (made on its own thread); a worker that cannot make one (no
+    // device) stops the run, and its error is rethrown here.
+    const auto workers = parallel_for(
+        int(batches.size()), jobs, [&] { return std::make_unique<Worker>(o.device); },
+        [&](int b, std::unique_ptr<Worker>& w) {
+            for (size_t i : batches[size_t(b)]) {
+                bool se = false;
+                TestCase tc = tests[i];
+                if (o.stability) tc.stability.enabled = true;
+                results[i] = run_test(tc, *w, store, out_dir, flip_threads, timing_repeats, se);
+                if (se) shader_error = true;
+                int n = ++done;
+                if (!o.quiet) {
+                    std::lock_guard lock(print_mutex);
+                    print_test_line(to_json(results[i]), n, tests.size(), interactive, budget);
                 }
-            std::lock_guard lock(driver_mutex);
-            if (json d = w.renderer.driver_json(); !d.empty()) driver = d;
-        } catch (...) { // escaping the thread, it would abort the process (SIGABRT) with no results
-            std::lock_guard lock(driver_mutex);
-            if (!failure) failure = std::current_exception();
-            next = batches.size();
-        }
-    };
-    std::vector<std::thread> pool;
-    pool.reserve(size_t(jobs));
-    for (int j = 0; j < jobs; ++j) pool.emplace_back(work);
-    for (auto& t : pool) t.join();
-    if (failure) std::rethrow_exception(failure);
+            }
+        });
+    json driver;
+    for (const auto& w : workers)
+        if (json d = w->renderer.driver_json(); !d.empty()) driver = d;
     return {std::move(results), std::move(driver), shader_error};
 }
 

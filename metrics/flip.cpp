@@ -17,7 +17,6 @@
 #include <cstring>
 #include <limits>
 #include <stdexcept>
-#include <thread>
 #include <vector>
 
 #include <fmt/core.h>
@@ -25,12 +24,12 @@
 #include "metrics/identical.h"
 
 #include "kernel/errors.h"
+#include "kernel/parallel_for.h"
 #include "metrics/flip/color_spaces.h"
 #include "metrics/flip/csf_filters.h"
 #include "metrics/flip/feature_detection.h"
 #include "metrics/flip/kernels.h"
 #include "metrics/flip/magma_table.h"
-#include "metrics/flip/parallel.h"
 #include "metrics/flip/pooling.h"
 
 namespace iblcheck {
@@ -79,20 +78,12 @@ class FlipEngine {
     // One LDR-FLIP evaluation. prep(img, y, x0, x1, R, G, B) writes columns [x0, x1) of row y of
     // image img (0 reference, 1 test) as linear RGB in [0,1] (R[0] is column x0). With max_merge,
     // out = max(out, FLIP) per pixel (HDR), otherwise out = FLIP.
+    // Every output pixel is computed by exactly one item with the same arithmetic: the results do not
+    // depend on the thread count or on which thread takes which item.
     template <class Prep> void evaluate(const Prep& prep, float* out, bool max_merge) {
-        const int workers = std::min(threads_, int(items_.size()));
-        auto work = [&](int t) {
-            Scratch s(*this);
-            for (size_t i = size_t(t); i < items_.size(); i += size_t(workers)) run_item(prep, items_[i], s, out, max_merge);
-        };
-        if (workers <= 1) {
-            work(0);
-            return;
-        }
-        std::vector<std::thread> pool;
-        for (int t = 1; t < workers; ++t) pool.emplace_back(work, t);
-        work(0);
-        for (auto& th : pool) th.join();
+        parallel_for(
+            int(items_.size()), threads_, [this] { return Scratch(*this); },
+            [&](int i, Scratch& s) { run_item(prep, items_[size_t(i)], s, out, max_merge); });
     }
 
   private:

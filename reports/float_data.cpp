@@ -3,13 +3,13 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
 #include <zlib.h>
 
 #include "image_io/image_io.h"
+#include "kernel/atomic_file.h"
 #include "kernel/errors.h"
 #include "kernel/hash.h"
 #include "kernel/output_files.h"
@@ -124,15 +124,8 @@ std::string DataStore::write(const std::string& meta_json, const std::string& pa
     if (fs::exists(file, ec))
         return key; // an earlier report into this folder wrote it  // same content: written by this report already
     fs::create_directories(file.parent_path(), ec);
-    const fs::path tmp = file.string() + ".tmp";
-    {
-        std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
-        if (!f) throw Error(fmt::format("{}: cannot write the report's image data", tmp.string()));
-        f << "iblcheckData(\"" << key << "\"," << meta_json << ",\"" << base64(packed) << "\");\n";
-        if (!f) throw Error(fmt::format("{}: write failed", tmp.string()));
-    }
-    fs::rename(tmp, file, ec);
-    if (ec) throw Error(fmt::format("{}: cannot write the report's image data: {}", file.string(), ec.message()));
+    write_file_atomically(file, "iblcheckData(\"" + key + "\"," + meta_json + ",\"" + base64(packed) + "\");\n",
+                          "the report's image data");
     return key;
 }
 

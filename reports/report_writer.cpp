@@ -6,13 +6,13 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <iterator>
 #include <map>
 #include <set>
 
 #include <fmt/format.h>
 
+#include "kernel/atomic_file.h"
 #include "kernel/errors.h"
 #include "kernel/shell_quote.h"
 #include "metrics/flip/magma_table.h"
@@ -350,21 +350,6 @@ void page_end(std::string& o, const ImageStore& store, const DataStore& data) {
                    data.files(), js_config(), assets::kJs);
 }
 
-// Written beside and renamed over index.html, so a reader never sees half a page.
-void write_atomically(const fs::path& out_dir, const std::string& o) {
-    const fs::path index = out_dir / "index.html";
-    const fs::path tmp = out_dir / "index.html.tmp";
-    {
-        std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
-        if (!f) throw Error(fmt::format("{}: cannot write the report", tmp.string()));
-        f << o;
-        if (!f) throw Error(fmt::format("{}: write failed", tmp.string()));
-    }
-    std::error_code ec;
-    fs::rename(tmp, index, ec);
-    if (ec) throw Error(fmt::format("{}: cannot write the report: {}", index.string(), ec.message()));
-}
-
 } // namespace
 
 void write_report(const json& results, const fs::path& results_dir, const fs::path& out_dir, const std::vector<json>& history,
@@ -402,7 +387,7 @@ void write_report(const json& results, const fs::path& results_dir, const fs::pa
     history_tab(o, tests, hist, trends);
     table_tab(o, tests, drift);
     page_end(o, store, data);
-    write_atomically(out_dir, o);
+    write_file_atomically(out_dir / "index.html", o, "the report"); // a reader never sees half a page
 }
 
 } // namespace iblcheck::report

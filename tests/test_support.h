@@ -1,5 +1,5 @@
 // Helpers every test file shares: private temporary folders, running the CLI, reading and writing
-// small text files.
+// small text files, the message of an InputError.
 #pragma once
 #include <sys/wait.h>
 #include <unistd.h>
@@ -10,6 +10,8 @@
 #include <fstream>
 #include <iterator>
 #include <string>
+
+#include "kernel/errors.h"
 
 namespace iblcheck::testutil {
 
@@ -41,6 +43,16 @@ inline std::string read_text(const std::filesystem::path& p) {
 inline void write_file(const std::filesystem::path& p, const std::string& text) {
     std::filesystem::create_directories(p.parent_path());
     std::ofstream(p) << text;
+}
+
+// The message of the InputError `f` throws; "(no error)" when it throws none.
+template <class F> std::string input_error_of(F&& f) {
+    try {
+        f();
+    } catch (const InputError& e) {
+        return e.what();
+    }
+    return "(no error)";
 }
 
 } // namespace iblcheck::testutil

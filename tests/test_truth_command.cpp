@@ -96,4 +96,25 @@ TEST_F(TruthCommand, FramesAndSppMustBePositive) {
     }
 }
 
+// --print-name answers the golden's name, the key a suite test reads, and renders and writes nothing: the
+// regeneration script asks it instead of spelling the rule again (its bash copy named a truth rendered
+// with --set threads=2 "sphere__studio__threads=2", a golden no test reads).
+TEST_F(TruthCommand, PrintNameIsTheGoldenStoresKeyAndWritesNothing) {
+    std::string out;
+    const std::string goldens = " --goldens " + path("goldens");
+    int rc = testutil::run_command(kCli +
+                                       " truth --print-name --scene sphere --env studio --set threads=2 --set roughness=0.5 "
+                                       "--set truth_tolerance=0.01 --size 32x32" +
+                                       goldens,
+                                   out);
+    EXPECT_EQ(rc, 0) << out;
+    EXPECT_EQ(out, "sphere__studio__roughness=0.5__32x32\n");
+    rc = testutil::run_command(kCli + " truth --print-name --frames 16 --scene sphere_field --env sky_sun" + goldens, out);
+    EXPECT_EQ(rc, 0) << out;
+    EXPECT_EQ(out, "sphere_field__sky_sun__frames=16\n");
+    rc = testutil::run_command(kCli + " truth --print-name --scene roughness_sweep --env blender:sunrise" + goldens, out);
+    EXPECT_EQ(out, "roughness_sweep__blender-sunrise\n");
+    EXPECT_TRUE(fs::is_empty(dir_)) << "nothing rendered or written";
+}
+
 } // namespace

@@ -7,18 +7,17 @@
 #include <chrono>
 #include <filesystem>
 
+#include "harness/golden_store.h"
 #include "harness/truth/truth_golden.h"
 #include "metrics/flip.h"
 
 namespace iblcheck::reference {
 
-// The golden writers' shared pieces (truth_golden.h): the same files, criterion and environment spelling as
-// the quadrature's goldens.
+// The golden writers' shared pieces (truth_golden.h): the same criterion and environment spelling as the
+// quadrature's goldens (both write through GoldenStore::write_golden).
 using truth::kCriterionFlip;
 using truth::kCriterionRelativeRmse;
 using truth::portable_env_spec;
-using truth::utc_now;
-using truth::write_golden_files;
 
 namespace {
 // Issue 5's convergence criterion on the noise floor between the two seeds, stated with its verdict.
@@ -67,10 +66,10 @@ MonteCarloGoldenWritten write_monte_carlo_golden(const MonteCarloGoldenRequest& 
     meta["spp"] = req.spp;
     meta["time_s"] = time_s;
     meta["command"] = req.command;
-    meta["date"] = utc_now();
+    meta["date"] = utc_now_iso();
     meta["image"] = std::filesystem::path(req.out_exr).filename().string(); // beside the sidecar: no machine path
     meta["channels"] = "R,G,B float32 linear";
-    write_golden_files(req.out_exr, nf.image_a, meta);
+    GoldenStore::write_golden(req.out_exr, nf.image_a, meta);
     return out;
 }
 

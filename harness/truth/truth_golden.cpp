@@ -1,13 +1,9 @@
 // One quadrature-truth golden and its sidecar (truth_golden.h).
 #include "harness/truth/truth_golden.h"
 
-#include <unistd.h>
-
-#include <cstring>
-#include <ctime>
 #include <filesystem>
-#include <fstream>
 
+#include "harness/golden_store.h"
 #include "image_io/image_io.h"
 #include "kernel/errors.h"
 #include "metrics/display_transform.h"
@@ -17,13 +13,6 @@
 namespace iblcheck::truth {
 
 std::string portable_env_spec(const TestSpec& spec) { return environment_label(spec.env, spec.env_name); }
-
-std::string utc_now() {
-    char date[64];
-    const std::time_t now = std::time(nullptr);
-    std::strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
-    return date;
-}
 
 GoldenDifference golden_difference(const std::string& new_exr, const std::string& old_exr) {
     const cv::Mat a = read_image(new_exr).pixels, o = read_image(old_exr).pixels;
@@ -51,52 +40,7 @@ void add_sphere_flip(nlohmann::json& per_sphere, const cv::Mat& errmap, const cv
         }
     for (size_t s = 0; s < sum.size(); ++s) per_sphere[s]["mean_flip"] = n[s] ? sum[s] / double(n[s]) : 0.0;
 }
-// Writes `text` to `file` through a temporary file renamed into place.
-void write_atomically(const std::filesystem::path& file, const std::string& text) {
-    std::filesystem::path tmp = file;
-    tmp += ".tmp" + std::to_string(::getpid());
-    {
-        std::ofstream f(tmp);
-        f << text;
-        if (!f) throw InputError(tmp.string() + ": cannot write");
-    }
-    std::error_code ec;
-    std::filesystem::rename(tmp, file, ec);
-    if (ec) {
-        std::filesystem::remove(tmp, ec);
-        throw InputError(file.string() + ": cannot write: " + ec.message());
-    }
-}
 } // namespace
-
-void write_golden_files(const std::string& exr_path, const cv::Mat& image, const nlohmann::json& meta) {
-    namespace fs = std::filesystem;
-    const fs::path exr(exr_path);
-    std::error_code ec;
-    if (exr.has_parent_path()) fs::create_directories(exr.parent_path(), ec);
-    // Bit-identical pixels are left as they are (a deterministic truth regenerated unchanged keeps its file).
-    bool same = false;
-    if (fs::exists(exr)) {
-        try {
-            const cv::Mat old = read_image(exr_path).pixels;
-            same = old.size() == image.size() && old.type() == image.type() && old.isContinuous() && image.isContinuous() &&
-                   std::memcmp(old.data, image.data, image.total() * image.elemSize()) == 0;
-        } catch (const Error&) {
-            same = false; // unreadable: replaced
-        }
-    }
-    fs::path tmp_exr = exr;
-    tmp_exr += ".tmp" + std::to_string(::getpid()) + ".exr";
-    if (!same) write_exr(tmp_exr.string(), image);
-    // The sidecar first: a reader that sees the new image always finds its provenance beside it.
-    write_atomically(fs::path(exr).replace_extension(".json"), meta.dump(2) + "\n");
-    if (same) return;
-    fs::rename(tmp_exr, exr, ec);
-    if (ec) {
-        fs::remove(tmp_exr, ec);
-        throw InputError(exr.string() + ": cannot write: " + ec.message());
-    }
-}
 
 GoldenWritten write_truth_golden(const GoldenRequest& req) {
     const Environment env = load_environment(req.spec.env);
@@ -140,10 +84,10 @@ GoldenWritten write_truth_golden(const GoldenRequest& req) {
                 {"provenance", prov},
                 {"time_s", prov["time_s"]},
                 {"command", req.command},
-                {"date", utc_now()},
+                {"date", utc_now_iso()},
                 {"image", exr.filename().string()},
                 {"channels", "R,G,B float32 linear"}};
-    write_golden_files(req.out_exr, r.fine.image, out.meta);
+    GoldenStore::write_golden(req.out_exr, r.fine.image, out.meta);
     return out;
 }
 
@@ -219,10 +163,10 @@ nlohmann::json write_truth_sequence_golden(const SequenceRequest& req) {
         {"threads", seq.threads},
         {"time_s", seq.seconds},
         {"command", req.command},
-        {"date", utc_now()},
+        {"date", utc_now_iso()},
         {"image", std::filesystem::path(req.out_exr).filename().string()},
         {"channels", "R,G,B float32 linear"}};
-    write_golden_files(req.out_exr, strip, meta);
+    GoldenStore::write_golden(req.out_exr, strip, meta);
     return meta;
 }
 

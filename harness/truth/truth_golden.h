@@ -61,17 +61,10 @@ struct SequenceRequest {
 };
 nlohmann::json write_truth_sequence_golden(const SequenceRequest& request);
 
-// A golden's EXR and its JSON sidecar (same path, .json), each through a temporary file renamed into
-// place, the sidecar first; an EXR whose pixels are bit-identical to the new ones is not rewritten.
-void write_golden_files(const std::string& exr_path, const cv::Mat& image, const nlohmann::json& meta);
-
 // The environment as recorded in a sidecar: its stable name (environment_label: a built-in spec, a
 // file's given name or file name; no absolute machine paths in goldens), beside the content hash that
 // identifies it.
 std::string portable_env_spec(const TestSpec& spec);
-
-// The current UTC time as a sidecar records it (2026-11-23T09:24:43Z).
-std::string utc_now();
 
 // How far a new golden is from an older one (`iblcheck truth --compare OLD.exr`): mean HDR-FLIP with the
 // old golden as the reference, and relative RMSE (monte_carlo.h's definition) over the new golden's

@@ -1,11 +1,9 @@
 #include "precompute_store.h"
 
-#include <unistd.h>
-
 #include <cstring>
 #include <fstream>
-#include <thread>
 
+#include "kernel/atomic_file.h"
 #include "kernel/cpu_caps.h"
 #include "kernel/hash.h"
 #include "kernel/profile.h"
@@ -198,18 +196,7 @@ void save_precompute(vk::Context& ctx, const std::string& key, const IblResource
 void write_store_entry(const fs::path& file, std::string_view bytes) {
     std::error_code ec;
     fs::create_directories(file.parent_path(), ec);
-    const fs::path tmp = fs::path(file).concat(".tmp" + std::to_string(::getpid()) + "-" +
-                                               std::to_string(std::hash<std::thread::id>{}(std::this_thread::get_id())));
-    {
-        std::ofstream o(tmp, std::ios::binary);
-        o.write(bytes.data(), std::streamsize(bytes.size()));
-        if (!o) {
-            fs::remove(tmp, ec);
-            return;
-        }
-    }
-    fs::rename(tmp, file, ec);
-    if (ec) fs::remove(tmp, ec);
+    try_write_file_atomically(file, bytes); // a failure is no error: the next run computes it again
 }
 
 } // namespace iblcheck

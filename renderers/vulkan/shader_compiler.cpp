@@ -15,6 +15,7 @@
 
 #include "fp16_emulation.h"
 #include "fp16_pass_hash.h" // generated: IBLCHECK_FP16_PASS_HASH
+#include "kernel/atomic_file.h"
 #include "kernel/errors.h"
 #include "kernel/hash.h"
 #include "kernel/profile.h"
@@ -277,16 +278,11 @@ void write_cached(const fs::path& file, const std::vector<uint32_t>& spirv) {
     std::error_code ec;
     fs::create_directories(file.parent_path(), ec);
     if (ec) return;
-    fs::path tmp = file;
-    tmp += ".tmp" + std::to_string(::getpid());
-    if (std::ofstream f{tmp, std::ios::binary}) {
-        const uint64_t hash = module_hash(spirv.data(), spirv.size());
-        const uint32_t trailer[kTrailerWords] = {uint32_t(hash), uint32_t(hash >> 32), kCacheTrailer};
-        f.write(reinterpret_cast<const char*>(spirv.data()), std::streamsize(spirv.size() * 4));
-        f.write(reinterpret_cast<const char*>(trailer), sizeof trailer);
-        f.close();
-        fs::rename(tmp, file, ec);
-    }
+    const uint64_t hash = module_hash(spirv.data(), spirv.size());
+    const uint32_t trailer[kTrailerWords] = {uint32_t(hash), uint32_t(hash >> 32), kCacheTrailer};
+    std::string bytes(reinterpret_cast<const char*>(spirv.data()), spirv.size() * 4);
+    bytes.append(reinterpret_cast<const char*>(trailer), sizeof trailer);
+    try_write_file_atomically(file, bytes);
 }
 
 // GLSL (version 460, Vulkan rules) to SPIR-V 1.5 for Vulkan 1.2, unoptimised. glslang's process

@@ -10,10 +10,10 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
-#include <thread>
 
 #include <fmt/format.h>
 
+#include "kernel/parallel_for.h"
 #include "renderers/option_table.h"
 #include "renderers/reference/monte_carlo/mc_adaptive.h"
 #include "renderers/reference/monte_carlo/mc_pixel.h"
@@ -86,18 +86,9 @@ std::string estimator_description(bool window, bool lobe_window, double compensa
            "inter-sphere occlusion";
 }
 
-// Runs row_fn(y, candidates scratch) for every row y < H on `threads` threads (rows handed out in order).
-template <class RowFn> void parallel_rows(int H, int threads, RowFn&& row_fn) {
-    std::atomic<int> next_row{0};
-    auto worker = [&] {
-        std::vector<int> cand;
-        for (int y; (y = next_row.fetch_add(1)) < H;) row_fn(y, cand);
-    };
-    std::vector<std::thread> pool;
-    for (int i = 1; i < threads; ++i) pool.emplace_back(worker);
-    worker();
-    for (auto& th : pool) th.join();
-}
+// Each row's pixels are written by that row alone, from hashes of the pixel and the seed: the same
+// bits for any thread count. A worker keeps its candidates list as scratch.
+std::vector<int> candidates_scratch() { return {}; }
 
 // The pilot pass of the adaptive counts (mc_adaptive.h): its own lighting keys, independent of the main
 // pass's; min(P, 32) positions of the pattern × 2 lighting samples per pixel. Returns the counts; adds the
@@ -110,7 +101,7 @@ std::vector<int> pilot_counts(const PixelContext& ctx, const McOptions& opt, uin
     const uint32_t pilot_hash = hash_u32(seed_hash ^ 0x3c6ef372u);
     const int pilot_pos = std::min(opt.positions, 32);
     std::atomic<long> pilot_n{0};
-    parallel_rows(H, threads, [&](int y, std::vector<int>& cand) {
+    parallel_for(H, threads, candidates_scratch, [&](int y, std::vector<int>& cand) {
         long f = 0;
         for (int x = 0; x < W; ++x) {
             const uint32_t pix = hash_u32(uint32_t(y) * uint32_t(W) + uint32_t(x));
@@ -132,7 +123,7 @@ std::vector<int> pilot_counts(const PixelContext& ctx, const McOptions& opt, uin
 void main_pass(const PixelContext& ctx, const McOptions& opt, uint32_t seed_hash, uint32_t pattern_hash, int threads,
                const std::vector<int>& counts, cv::Mat& image, cv::Mat& coverage, std::vector<long>& row_fetches) {
     const int W = ctx.W;
-    parallel_rows(ctx.H, threads, [&](int y, std::vector<int>& cand) {
+    parallel_for(ctx.H, threads, candidates_scratch, [&](int y, std::vector<int>& cand) {
         long fetches = 0;
         for (int x = 0; x < W; ++x) {
             const uint32_t pix = hash_u32(uint32_t(y) * uint32_t(W) + uint32_t(x));
@@ -213,8 +204,7 @@ ReferenceRender render_reference_full(const TestSpec& spec, const Environment* e
     const int W = spec.width > 0 ? spec.width : scene.width;
     const int H = spec.height > 0 ? spec.height : scene.height;
     int threads = opt.threads;
-    if (threads == 0) threads = int(std::max(1u, std::thread::hardware_concurrency()));
-    threads = std::min(threads, H);
+    threads = std::min(resolve_threads(threads), H); // as the provenance records it
 
     cv::Mat image(H, W, CV_32FC3, cv::Scalar(0, 0, 0));
     cv::Mat coverage(H, W, CV_32FC1, cv::Scalar(0));

@@ -9,8 +9,9 @@
 #include <cmath>
 #include <cstdint>
 #include <mutex>
-#include <thread>
 #include <unordered_map>
+
+#include "kernel/parallel_for.h"
 
 namespace iblcheck::truth {
 
@@ -224,19 +225,12 @@ NormalTable::NormalTable(const EnvPyramid& env, const MaterialLobe& lobe, V3 v, 
     };
     // Coarse grid nodes first (shared by the cells), then the cells; both in parallel, deterministic.
     std::vector<float> grid(size_t(n_ + 1) * (n_ + 1) * 3, 0.0f);
-    std::atomic<int> next{0}, done{0};
-    std::atomic<long> nodes{0}, evals{0}, reused{0};
+    std::atomic<int> done{0};
     std::mutex m;
-    auto run = [&](auto&& body) {
-        next = 0;
-        std::vector<std::thread> pool;
-        for (int t = 1; t < std::max(1, threads); ++t) pool.emplace_back(body);
-        body();
-        for (auto& th : pool) th.join();
-    };
-    run([&] {
-        Builder b{*this, env, lobe, tp, qp, tp.floor};
-        for (int j; (j = next.fetch_add(1)) <= n_;)
+    // Each grid row and each cell is written by its own index; the builders' counts are summed after the join.
+    const std::vector<Builder> node_builders = parallel_for(
+        n_ + 1, threads, [&] { return Builder{*this, env, lobe, tp, qp, tp.floor}; },
+        [&](int j, Builder& b) {
             for (int i = 0; i <= n_; ++i) {
                 bool use = false;
                 for (int dj = -1; dj <= 0; ++dj)
@@ -244,12 +238,11 @@ NormalTable::NormalTable(const EnvPyramid& env, const MaterialLobe& lobe, V3 v, 
                         use |= i + di >= 0 && j + dj >= 0 && i + di < n_ && j + dj < n_ && needed(i + di, j + dj);
                 if (use) b.value(x0_ + i * coarse_, x0_ + j * coarse_, &grid[(size_t(j) * (n_ + 1) + i) * 3]);
             }
-        nodes += b.nodes, evals += b.evals;
-    });
+        });
     SharedNodes shared;
-    run([&] {
-        Builder b{*this, env, lobe, tp, qp, tp.floor, &shared};
-        for (int k; (k = next.fetch_add(1)) < n_ * n_;) {
+    const std::vector<Builder> cell_builders = parallel_for(
+        n_ * n_, threads, [&] { return Builder{*this, env, lobe, tp, qp, tp.floor, &shared}; },
+        [&](int k, Builder& b) {
             const int i = k % n_, j = k / n_;
             if (needed(i, j)) {
                 std::vector<Cell>& tree = trees_[size_t(k)];
@@ -263,10 +256,9 @@ NormalTable::NormalTable(const EnvPyramid& env, const MaterialLobe& lobe, V3 v, 
                 std::lock_guard<std::mutex> lock(m);
                 progress(double(d) / (double(n_) * n_));
             }
-        }
-        nodes += b.nodes, evals += b.evals, reused += b.reused;
-    });
-    nodes_ = nodes, evals_ = evals, shared_ = reused;
+        });
+    for (const std::vector<Builder>* builders : {&node_builders, &cell_builders})
+        for (const Builder& b : *builders) nodes_ += b.nodes, evals_ += b.evals, shared_ += b.reused;
 }
 
 long NormalTable::leaves() const {

@@ -3,9 +3,9 @@
 
 #include <chrono>
 #include <string>
-#include <thread>
 
 #include "kernel/errors.h"
+#include "kernel/parallel_for.h"
 #include "renderers/option_table.h"
 
 namespace iblcheck::truth {
@@ -22,7 +22,7 @@ TruthSequence render_truth_sequence(const TestSpec& spec, const Environment& env
     out.bound_frames = bound_frames;
     int threads = option_int(spec.options, "threads", "reference");
     if (threads < 0) throw UsageError("option 'threads': must be >= 0");
-    out.threads = threads > 0 ? threads : int(std::max(1u, std::thread::hardware_concurrency()));
+    out.threads = resolve_threads(threads);
     Environment env = env_in;
     if (spec.options.has("env_rotation")) env.rotation_deg = float(option_double(spec.options, "env_rotation", "reference"));
     const EnvPyramid pyramid(env);
