@@ -8,7 +8,6 @@
 #include "bless.h"
 #include "kernel/errors.h"
 #include "kernel/profile.h"
-#include "metrics/catalog.h"
 #include "metrics/image_compare.h"
 #include "provenance.h"
 #include "sphere_errors.h"

@@ -15,7 +15,7 @@
 #include "harness/suite.h"
 #include "kernel/errors.h"
 #include "renderers/vulkan/shader_compiler.h"
-#include "renderers/vulkan/spirv_samples.h"
+#include "renderers/vulkan/spirv_texture_samples.h"
 #include "tests/test_support.h"
 
 namespace fs = std::filesystem;

@@ -15,7 +15,7 @@
 #include "renderers/scenes/scene.h"
 #include "renderers/vulkan/fp16_emulation.h"
 #include "renderers/vulkan/shader_compiler.h"
-#include "renderers/vulkan/spirv_samples.h"
+#include "renderers/vulkan/spirv_texture_samples.h"
 #include "shading_cost.h"
 
 namespace iblcheck {
@@ -114,7 +114,7 @@ double texture_samples_per_hit(const MobileOptions& m) {
 }
 
 // A team's shading (docs/SHADER_CONTRACT.md) does its own lookups: its texture samples per shading
-// are read from its SPIR-V (spirv_samples.h), the module already compiled for the pass.
+// are read from its SPIR-V (spirv_texture_samples.h), the module already compiled for the pass.
 double contract_samples_per_hit(const vk::Defines& defines, const vk::CompileOptions& options, bool fragment) {
     const vk::CompiledShader module =
         vk::compile_shader(fragment ? "shade_spheres.frag" : "shade_spheres.comp", defines, options);

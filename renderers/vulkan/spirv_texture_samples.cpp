@@ -1,4 +1,4 @@
-#include "spirv_samples.h"
+#include "spirv_texture_samples.h"
 
 #include <map>
 #include <set>
