@@ -14,6 +14,7 @@
 #include <set>
 #include <string>
 
+#include "harness/metrics_store.h"
 #include "harness/runner.h"
 #include "harness/suite.h"
 #include "kernel/hash.h"
@@ -378,6 +379,98 @@ TEST(CostStore, AStoredCountIsTheCountedOneAndAChangedInputMisses) {
     EXPECT_TRUE(edited.is_number() && edited != json(12345.0)) << edited;
     EXPECT_EQ(entries(dir), specs.size() + 5);
     fs::remove_all(dir);
+}
+
+namespace {
+
+// One furnace test judged linearly and one scored on a display too (its LDR-FLIP map is stored as well).
+const char* kMetricsSuite = R"({
+  "suite": "mini",
+  "defaults": {"env": "constant:1",
+               "baseline_tolerances": {"flip.mean": {"max": 0.001}, "ssim.mean": {"min": 0.999}},
+               "reference_band": {"flip.mean": {"below": 0.2, "above": 0.1, "abs": 0.0}}},
+  "tests": [{"scene": "furnace", "method": "mobile", "variants": [{}]},
+            {"scene": "furnace", "method": "mobile", "variants": [{}],
+             "display": {"tonemap": "aces_narkowicz", "exposure": 0, "quantize": "srgb8"}}]
+})";
+
+// What the store stands in for, per test: the comparisons (metrics, checks, worst block), the
+// accuracy and the per-sphere errors (read from the linear FLIP map).
+json measured_parts(const RunSummary& run) {
+    json out = json::object();
+    for (const json& t : run.results["tests"])
+        out[t["name"].get<std::string>()] = {t["comparisons"], t["accuracy"], t["per_sphere"], t["verdict"]};
+    return out;
+}
+
+RunSummary run_with_metrics_store(const FurnaceStore& store, const std::string& metrics_store) {
+    setenv("IBLCHECK_METRICS_CACHE", metrics_store.c_str(), 1);
+    RunOptions o;
+    o.suite = store.suite.string();
+    o.goldens = store.goldens;
+    o.quiet = true;
+    RunSummary r = run_suite(o);
+    unsetenv("IBLCHECK_METRICS_CACHE");
+    return r;
+}
+
+} // namespace
+
+// The metrics of a render against its truth, stored, are the computed ones: a warm run equals a cold
+// one and one with the store off, comparisons, accuracy and per-sphere errors alike (the linear map
+// and a display test's LDR-FLIP map are stored with the figures). Bit-identical pairs (a render equal
+// to its baseline) are not stored. Every entry made to hold a planted figure: the run reports it (read,
+// not measured again). Every entry cut in half: measured again, the same. The key changes with either
+// image's pixels, size or type, the display space and the build.
+TEST(MetricsStore, AStoredComparisonIsTheComputedOneAndAChangedInputMisses) {
+    FurnaceStore store("metrics_store", kMetricsSuite);
+    const fs::path dir = store.dir / "metrics";
+    setenv("IBLCHECK_METRICS_CACHE", dir.c_str(), 1); // bless measures too: not into the checkout's store
+    ASSERT_EQ(store.bless_all(), kExitPass);
+    unsetenv("IBLCHECK_METRICS_CACHE");
+    fs::remove_all(dir);
+
+    const RunSummary off = run_with_metrics_store(store, "0");
+    ASSERT_EQ(off.exit_code(), kExitPass) << off.results.dump(1);
+    const json expected = measured_parts(off);
+    const RunSummary cold = run_with_metrics_store(store, dir.string());
+    EXPECT_EQ(measured_parts(cold), expected);
+    ASSERT_EQ(entries(dir), 2u); // the two truth comparisons; the baselines are bit-identical
+    const RunSummary warm = run_with_metrics_store(store, dir.string());
+    EXPECT_EQ(measured_parts(warm), expected);
+
+    for (const auto& e : fs::directory_iterator(dir)) {
+        const std::string key = e.path().stem().string();
+        setenv("IBLCHECK_METRICS_CACHE", dir.c_str(), 1);
+        std::optional<Measured> m = load_measured(key);
+        ASSERT_TRUE(m.has_value()) << e.path();
+        m->linear.mean = 0.123456;
+        save_measured(key, *m);
+        unsetenv("IBLCHECK_METRICS_CACHE");
+    }
+    const RunSummary planted = run_with_metrics_store(store, dir.string());
+    for (const json& t : planted.results["tests"]) EXPECT_EQ(t["accuracy"]["flip_mean"], json(0.123456)) << t["name"];
+
+    for (const auto& e : fs::directory_iterator(dir)) fs::resize_file(e.path(), fs::file_size(e.path()) / 2);
+    const RunSummary damaged = run_with_metrics_store(store, dir.string());
+    EXPECT_EQ(measured_parts(damaged), expected);
+
+    cv::Mat golden(24, 32, CV_32FC3), test;
+    cv::randu(golden, 0.0f, 4.0f);
+    test = golden * 1.01f;
+    const std::string key = metrics_store_key(golden, test, nullptr, "build A");
+    EXPECT_EQ(metrics_store_key(golden.clone(), test.clone(), nullptr, "build A"), key);
+    cv::Mat pixel = test.clone();
+    pixel.at<cv::Vec3f>(23, 31)[2] += 1e-3f;
+    cv::Mat other_golden = golden.clone();
+    other_golden.at<cv::Vec3f>(0, 0)[0] = 0;
+    const DisplaySpace aces, neutral{DisplayTonemap::pbr_neutral};
+    EXPECT_NE(metrics_store_key(golden, pixel, nullptr, "build A"), key);
+    EXPECT_NE(metrics_store_key(other_golden, test, nullptr, "build A"), key);
+    EXPECT_NE(metrics_store_key(golden.reshape(3, 32), test.reshape(3, 32), nullptr, "build A"), key); // 32x24
+    EXPECT_NE(metrics_store_key(golden, test, &aces, "build A"), key);
+    EXPECT_NE(metrics_store_key(golden, test, &aces, "build A"), metrics_store_key(golden, test, &neutral, "build A"));
+    EXPECT_NE(metrics_store_key(golden, test, nullptr, "build B"), key);
 }
 
 // `--version` reads the commit from iblcheck_commit.txt beside the binary (written at every build),
