@@ -303,6 +303,44 @@ TEST(Scene, CoverageIsTheSphereAtEachPixelCentre) {
     }
 }
 
+namespace {
+// The pixels whose coverage is not the sphere the camera ray through the centre hits (-1: background).
+int wrong_coverage_pixels(const Scene& s, const SphereCoverage& c) {
+    int wrong = 0;
+    for (int y = 0; y < c.ids.rows; ++y)
+        for (int x = 0; x < c.ids.cols; ++x) {
+            Vec3f o, d;
+            camera_ray(s, c.ids.cols, c.ids.rows, x + 0.5, y + 0.5, o, d);
+            const Hit hit = intersect(s, o, d);
+            wrong += c.ids.at<int>(y, x) != (hit.hit ? hit.sphere : -1);
+        }
+    return wrong;
+}
+} // namespace
+
+// The coverage is traced once per geometry and size in a process (issue 33), and what it depends on
+// is in that key: a moved or resized sphere, another camera or size gets its own map, and a map handed
+// out is the caller's (changing it changes no later one).
+TEST(Scene, CoverageOfAChangedGeometryIsTracedAgain) {
+    const Scene base = build_scene("roughness_sweep", {});
+    SphereCoverage first = sphere_coverage(base, 132, 24);
+    ASSERT_EQ(wrong_coverage_pixels(base, first), 0);
+    first.ids.setTo(7);
+    EXPECT_EQ(wrong_coverage_pixels(base, sphere_coverage(base, 132, 24)), 0);
+    Scene moved = base, resized = base, zoomed = base, turned = base, perspective = base;
+    moved.spheres[1].center.x += 0.3f;
+    resized.spheres[2].radius *= 0.5f;
+    zoomed.camera.half_height *= 0.8f;
+    turned.camera.eye = {0.5f, 0.2f, 5.0f};
+    perspective.camera.orthographic = false;
+    for (const Scene* s : {&moved, &resized, &zoomed, &turned, &perspective}) {
+        const SphereCoverage c = sphere_coverage(*s, 132, 24);
+        EXPECT_EQ(wrong_coverage_pixels(*s, c), 0);
+        EXPECT_GT(cv::countNonZero(c.ids != sphere_coverage(base, 132, 24).ids), 0); // the change shows
+    }
+    EXPECT_EQ(wrong_coverage_pixels(base, sphere_coverage(base, 66, 12)), 0);
+}
+
 TEST(Scene, CameraConvention) {
     Scene s = build_scene("sphere", {});
     Vec3f o, d;
