@@ -13,6 +13,7 @@
 #include "kernel/errors.h"
 #include "kernel/hash.h"
 #include "kernel/output_files.h"
+#include "kernel/parallel_for.h"
 #include "metrics/display_transform.h"
 #include "metrics/flip/tone_mappers.h"
 
@@ -60,7 +61,7 @@ std::vector<uint16_t> to_half(const cv::Mat& linear) {
 std::string pack_bytes(const std::vector<uint8_t>& bytes) {
     uLongf n = compressBound(uLong(bytes.size()));
     std::string out(n, '\0');
-    if (compress2(reinterpret_cast<Bytef*>(out.data()), &n, bytes.data(), uLong(bytes.size()), 6) != Z_OK)
+    if (compress2(reinterpret_cast<Bytef*>(out.data()), &n, bytes.data(), uLong(bytes.size()), Z_BEST_SPEED) != Z_OK)
         throw Error("report: zlib could not compress image data");
     out.resize(n);
     return out;
@@ -135,47 +136,77 @@ namespace {
 fs::path resolve(const fs::path& dir, const std::string& rel) { return inside_folder(dir, rel); }
 } // namespace
 
+namespace {
+// An EXR's figures and its packed half floats: what image() writes, read and computed without
+// touching the store (prepare() runs it on several threads). Nullopt for a missing or unreadable file.
+std::optional<PreparedImage> prepare_image(const fs::path& src) {
+    std::error_code ec;
+    if (!fs::is_regular_file(src, ec)) return std::nullopt;
+    try {
+        LoadedImage li = read_image(src.string());
+        cv::Mat m = li.pixels;
+        if (li.file_channels == 1) cv::extractChannel(li.pixels, m, 0); // an error map
+        const std::vector<uint16_t> half = to_half(m);
+        PreparedImage p;
+        FloatImageInfo& fi = p.info;
+        fi.width = m.cols;
+        fi.height = m.rows;
+        fi.channels = m.channels();
+        fi.auto_exposure = auto_exposure(m);
+        double mn = 0, mx = 0;
+        cv::minMaxLoc(m.reshape(1), &mn, &mx);
+        fi.max = mx;
+        {
+            cv::Mat flat = m.reshape(1).clone();
+            std::vector<float> v(flat.begin<float>(), flat.end<float>());
+            const size_t k = size_t(std::ceil(0.99 * double(v.size()))) - 1;
+            std::nth_element(v.begin(), v.begin() + long(k), v.end());
+            fi.p99 = v[k];
+        }
+        Fnv1a64 h;
+        h.update("f16");
+        h.update(&fi.width, sizeof fi.width);
+        h.update(&fi.height, sizeof fi.height);
+        h.update(&fi.channels, sizeof fi.channels);
+        h.update(half.data(), half.size() * 2);
+        p.hash = h.value();
+        p.meta = fmt::format("{{\"w\":{},\"h\":{},\"c\":{},\"enc\":\"f16\",\"auto\":{},\"max\":{},\"p99\":{}}}", fi.width,
+                             fi.height, fi.channels, fi.auto_exposure, std::isfinite(fi.max) ? fi.max : 0.0,
+                             std::isfinite(fi.p99) ? fi.p99 : 0.0);
+        p.packed = pack_half(half);
+        return p;
+    } catch (const InputError&) {
+        return std::nullopt; // an unreadable EXR: the page keeps the PNG
+    }
+}
+} // namespace
+
+void DataStore::prepare(const std::vector<std::string>& exr_rels, int threads) {
+    std::vector<std::string> todo;
+    for (const std::string& rel : exr_rels)
+        if (!rel.empty() && !images_.count(rel) && !prepared_.count(rel) &&
+            std::find(todo.begin(), todo.end(), rel) == todo.end())
+            todo.push_back(rel);
+    std::vector<std::optional<PreparedImage>> done(todo.size());
+    parallel_for(int(todo.size()), threads,
+                 [&](int i) { done[size_t(i)] = prepare_image(resolve(results_dir_, todo[size_t(i)])); });
+    for (size_t i = 0; i < todo.size(); ++i) prepared_[todo[i]] = std::move(done[i]);
+}
+
 std::optional<FloatImageInfo> DataStore::image(const std::string& exr_rel) {
     if (exr_rel.empty()) return std::nullopt;
     if (auto it = images_.find(exr_rel); it != images_.end()) return it->second;
+    std::optional<PreparedImage> p;
+    if (auto it = prepared_.find(exr_rel); it != prepared_.end()) {
+        p = std::move(it->second);
+        prepared_.erase(it);
+    } else {
+        p = prepare_image(resolve(results_dir_, exr_rel));
+    }
     std::optional<FloatImageInfo> info;
-    std::error_code ec;
-    const fs::path src = resolve(results_dir_, exr_rel);
-    if (fs::is_regular_file(src, ec)) {
-        try {
-            LoadedImage li = read_image(src.string());
-            cv::Mat m = li.pixels;
-            if (li.file_channels == 1) cv::extractChannel(li.pixels, m, 0); // an error map
-            const std::vector<uint16_t> half = to_half(m);
-            FloatImageInfo fi;
-            fi.width = m.cols;
-            fi.height = m.rows;
-            fi.channels = m.channels();
-            fi.auto_exposure = auto_exposure(m);
-            double mn = 0, mx = 0;
-            cv::minMaxLoc(m.reshape(1), &mn, &mx);
-            fi.max = mx;
-            {
-                cv::Mat flat = m.reshape(1).clone();
-                std::vector<float> v(flat.begin<float>(), flat.end<float>());
-                const size_t k = size_t(std::ceil(0.99 * double(v.size()))) - 1;
-                std::nth_element(v.begin(), v.begin() + long(k), v.end());
-                fi.p99 = v[k];
-            }
-            Fnv1a64 h;
-            h.update("f16");
-            h.update(&fi.width, sizeof fi.width);
-            h.update(&fi.height, sizeof fi.height);
-            h.update(&fi.channels, sizeof fi.channels);
-            h.update(half.data(), half.size() * 2);
-            const std::string meta = fmt::format(
-                "{{\"w\":{},\"h\":{},\"c\":{},\"enc\":\"f16\",\"auto\":{},\"max\":{},\"p99\":{}}}", fi.width, fi.height,
-                fi.channels, fi.auto_exposure, std::isfinite(fi.max) ? fi.max : 0.0, std::isfinite(fi.p99) ? fi.p99 : 0.0);
-            fi.key = write(meta, pack_half(half), h.value());
-            info = fi;
-        } catch (const InputError&) {
-            info.reset(); // an unreadable EXR: the page keeps the PNG
-        }
+    if (p) {
+        info = p->info;
+        info->key = write(p->meta, p->packed, p->hash);
     }
     images_[exr_rel] = info;
     return info;

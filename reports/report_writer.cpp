@@ -352,6 +352,26 @@ void page_end(std::string& o, const ImageStore& store, const DataStore& data) {
 
 } // namespace
 
+namespace {
+// The EXRs the tests' viewers show (report_card.cpp's comparison_html() and its fallback to the
+// render alone), for DataStore::prepare().
+std::vector<std::string> viewer_exrs(const std::vector<const json*>& tests) {
+    std::vector<std::string> exrs;
+    for (const json* t : tests) {
+        bool shown = false;
+        if (t->contains("comparisons") && (*t)["comparisons"].is_array())
+            for (const json& c : (*t)["comparisons"]) {
+                const json& imgs = sub(c, "images");
+                if (str(imgs, "test").empty() && str(imgs, "golden").empty()) continue;
+                shown = shown || !str(imgs, "test").empty();
+                for (const char* k : {"test_exr", "golden_exr", "error_exr"}) exrs.push_back(str(imgs, k));
+            }
+        if (!shown) exrs.push_back(str(*t, "image_exr"));
+    }
+    return exrs;
+}
+} // namespace
+
 void write_report(const json& results, const fs::path& results_dir, const fs::path& out_dir, const std::vector<json>& history,
                   const std::vector<json>& findings) {
     validate_results(results, (results_dir / "results.json").string());
@@ -364,6 +384,7 @@ void write_report(const json& results, const fs::path& results_dir, const fs::pa
     PageContext ctx{store, data};
 
     const std::vector<const json*> tests = page_order(results);
+    data.prepare(viewer_exrs(tests));
     std::map<std::string, int> counts = verdict_counts(tests);
     const bool bad = counts["fail"] + counts["error"] + counts["missing-golden"] > 0;
     const json current = history_entry(results);

@@ -11,7 +11,10 @@
 #include <cmath>
 #include <fstream>
 
+#include <zlib.h>
+
 #include "cli/report_command.h"
+#include "image_io/image_io.h"
 #include "kernel/errors.h"
 #include "reports/drift.h"
 #include "reports/float_data.h"
@@ -197,6 +200,52 @@ TEST(FloatData, HalfFloatsSurviveThePackingAndTheAutoExposureSeesTheBrightEnd) {
     cv::Mat sun(10, 10, CV_32FC3, cv::Scalar(4, 4, 4));
     sun.at<cv::Vec3f>(0, 0) = cv::Vec3f(1e5f, 1e5f, 1e5f);
     EXPECT_NEAR(report::auto_exposure(sun), report::auto_exposure(c4), 0.05);
+}
+
+// The page's data at zlib's fastest level (issue 33): level 6 was most of the report's time. The
+// packed bytes are level 1's and inflate to the same bytes.
+TEST(FloatData, PackingIsZlibsFastestLevel) {
+    std::vector<uint8_t> bytes(20000);
+    for (size_t i = 0; i < bytes.size(); ++i) bytes[i] = uint8_t((i * i / 7 + i / 300) & 0xff);
+    const std::string packed = report::pack_bytes(bytes);
+    EXPECT_EQ(report::unpack(packed), bytes);
+    for (int level : {1, 6}) {
+        uLongf n = compressBound(uLong(bytes.size()));
+        std::string z(n, '\0');
+        ASSERT_EQ(compress2(reinterpret_cast<Bytef*>(z.data()), &n, bytes.data(), uLong(bytes.size()), level), Z_OK);
+        z.resize(n);
+        EXPECT_EQ(packed == z, level == 1) << "level " << level;
+    }
+}
+
+// DataStore::prepare() reads and packs on several threads what image() then writes: the same figures
+// and the same data script as image() alone, and what the page never asks for is never written.
+TEST(FloatData, PreparedImagesAreWrittenAsImageWritesThemAndOnlyWhenAsked) {
+    const fs::path dir = testutil::temp_dir("float_data_prepare");
+    fs::create_directories(dir / "images");
+    std::vector<std::string> rels;
+    for (int k = 0; k < 5; ++k) {
+        cv::Mat m(12, 20, CV_32FC3);
+        cv::randu(m, 0.0f, float(1 + k));
+        rels.push_back("images/e" + std::to_string(k) + ".exr");
+        write_exr((dir / rels.back()).string(), m);
+    }
+    report::DataStore alone(dir, dir / "alone"), prepared(dir, dir / "prepared");
+    prepared.prepare({rels[0], rels[1], rels[2], rels[3], rels[4], rels[1], "images/missing.exr", ""}, 3);
+    for (int k : {3, 0, 1}) {
+        const auto a = alone.image(rels[size_t(k)]), p = prepared.image(rels[size_t(k)]);
+        ASSERT_TRUE(a && p) << rels[size_t(k)];
+        EXPECT_EQ(p->key, a->key);
+        EXPECT_EQ(p->auto_exposure, a->auto_exposure);
+        EXPECT_EQ(p->p99, a->p99);
+        EXPECT_EQ(p->max, a->max);
+        EXPECT_EQ(testutil::read_text(dir / "prepared" / "data" / (p->key + ".js")),
+                  testutil::read_text(dir / "alone" / "data" / (a->key + ".js")));
+    }
+    EXPECT_FALSE(prepared.image("images/missing.exr").has_value());
+    EXPECT_EQ(prepared.files(), 3u);
+    EXPECT_EQ(std::distance(fs::directory_iterator(dir / "prepared" / "data"), fs::directory_iterator()), 3);
+    fs::remove_all(dir);
 }
 
 // ---- what a failure says (verdict_text.h): the terminal and the card print the same lines ----
