@@ -74,14 +74,23 @@ PoolOutcome run_tests(const std::vector<TestCase>& tests, const RunOptions& o, c
     return {std::move(results), std::move(driver), shader_error};
 }
 
+// What a run records about its start: the time and the provenance (commit, CPU), taken before the
+// first test. Taken after the tests, a nightly recorded its end as its start and the commit checked
+// out by then (a bisect or a pull during the run), not the one it ran.
+struct RunStart {
+    std::string started = utc_now_iso();
+    json provenance = run_provenance();
+};
+
 // The results document (results/RESULTS_FORMAT.md): the run's facts, every test, the counts.
-void record_run(RunSummary& s, const std::string& suite, const RunOptions& o, PoolOutcome& pool, double total_s) {
+void record_run(RunSummary& s, const std::string& suite, const RunOptions& o, const RunStart& start, PoolOutcome& pool,
+                double total_s) {
     RunResults run;
     run.suite = suite;
     run.command = o.command_line;
-    run.started = utc_now_iso();
+    run.started = start.started;
     run.total_s = total_s;
-    json prov = run_provenance();
+    const json& prov = start.provenance;
     std::string commit = prov["commit"];
     run.dirty = commit.size() > 6 && commit.substr(commit.size() - 6) == "-dirty";
     run.commit = run.dirty ? commit.substr(0, commit.size() - 6) : commit;
@@ -176,9 +185,10 @@ RunSummary run_suite(const RunOptions& options) {
     profile::take(); // this thread's stages before the run (none counted twice)
 
     const auto t0 = std::chrono::steady_clock::now();
+    const RunStart start;
     PoolOutcome pool = run_tests(tests, o, folder.dir(), store, jobs, suite.timing_repeats);
     RunSummary s;
-    record_run(s, suite.name, o, pool, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    record_run(s, suite.name, o, start, pool, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     try {
         write_outputs(s.results, o, folder);
     } catch (const InputError& e) { // a full disk: the run is lost, --out is not

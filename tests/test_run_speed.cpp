@@ -6,7 +6,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include <chrono>
 #include <cstring>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -471,6 +473,44 @@ TEST(MetricsStore, AStoredComparisonIsTheComputedOneAndAChangedInputMisses) {
     EXPECT_NE(metrics_store_key(golden, test, &aces, "build A"), key);
     EXPECT_NE(metrics_store_key(golden, test, &aces, "build A"), metrics_store_key(golden, test, &neutral, "build A"));
     EXPECT_NE(metrics_store_key(golden, test, nullptr, "build B"), key);
+}
+
+namespace {
+// Seconds since the epoch of "YYYY-MM-DDTHH:MM:SSZ".
+std::time_t parse_utc(const std::string& iso) {
+    std::tm tm{};
+    EXPECT_NE(strptime(iso.c_str(), "%Y-%m-%dT%H:%M:%SZ", &tm), nullptr) << iso;
+    return timegm(&tm);
+}
+} // namespace
+
+// A run's `started` is its start: taken before the first test, not after the last (the nightly of
+// 2026-11-26 recorded its end, 48 minutes later, and the commit checked out by then). The run is made
+// to last: each of its two tests is rendered 20 times at 640x480 (timing_repeats); when it still took under 2.5 s
+// the start and the end fall within the timestamp's second and cannot be told apart (skipped, said).
+TEST(RunFacts, StartedIsTakenBeforeTheTests) {
+    FurnaceStore store("run_started", R"({
+  "suite": "mini",
+  "defaults": {"env": "constant:1", "timing_repeats": 20, "size": "640x480",
+               "baseline_tolerances": {"flip.mean": {"max": 0.001}}},
+  "tests": [{"scene": "furnace", "method": "mobile", "variants": [{}, {"storage": "rgbm8"}], "reference": false}]
+})");
+    setenv("IBLCHECK_METRICS_CACHE", "0", 1);
+    ASSERT_EQ(store.bless_all(), kExitPass);
+    RunOptions o;
+    o.suite = store.suite.string();
+    o.goldens = store.goldens;
+    o.quiet = true;
+    const std::time_t before = std::time(nullptr);
+    const auto t0 = std::chrono::steady_clock::now();
+    const RunSummary run = run_suite(o);
+    const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    unsetenv("IBLCHECK_METRICS_CACHE");
+    ASSERT_EQ(run.exit_code(), kExitPass);
+    const std::time_t started = parse_utc(run.results["started"].get<std::string>());
+    if (took < 2.5) GTEST_SKIP() << "the run took " << took << " s: its start and end are within a second";
+    EXPECT_GE(started, before);
+    EXPECT_LE(started, before + 1) << "started " << run.results["started"] << ", the run took " << took << " s";
 }
 
 // `--version` reads the commit from iblcheck_commit.txt beside the binary (written at every build),
