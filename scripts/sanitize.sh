@@ -36,18 +36,18 @@ done
 echo "[sanitize] TSan build of iblcheck"
 cmake -S "$root" -B "$root/build-tsan" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DIBLCHECK_SANITIZE=thread >/dev/null
 build_or_fail "$root/build-tsan" "$root/build-tsan/build.log" iblcheck
-out="$(mktemp -d)" store="$(mktemp -d)"
+out="$(mktemp -d)" store="$(mktemp -d)" metrics_store="$(mktemp -d)"
 log="$root/build-tsan/run.log"
 # halt_on_error=0 so every race is listed; exitcode 66 marks a run that reported any.
 export TSAN_OPTIONS="suppressions=$root/tests/sanitizers/tsan.supp:halt_on_error=0:exitcode=66:second_deadlock_stack=1"
 set +e
-# An empty precompute store of its own: the workers compute and store every precompute under TSan,
-# as before the store existed, rather than read the main build's entries.
-IBLCHECK_PRECOMPUTE_CACHE="$store" IBLCHECK_CLI_PATH="$root/build-tsan/iblcheck" "$root/build-tsan/iblcheck" run --suite ci --jobs 2 -q \
+# Empty precompute and metrics stores of its own: the workers compute and store every precompute
+# and measure every comparison under TSan, as before the stores existed.
+IBLCHECK_PRECOMPUTE_CACHE="$store" IBLCHECK_METRICS_CACHE="$metrics_store" IBLCHECK_CLI_PATH="$root/build-tsan/iblcheck" "$root/build-tsan/iblcheck" run --suite ci --jobs 2 -q \
   --filter 'mobile.roughness_sweep.studio.*' --out "$out" >"$log" 2>&1
 rc=$?
 set -e
-rm -rf "$out" "$store"
+rm -rf "$out" "$store" "$metrics_store"
 if [[ $rc -ne 0 ]] || grep -q "WARNING: ThreadSanitizer" "$log"; then
   grep -A30 "WARNING: ThreadSanitizer" "$log" | head -120
   echo "[sanitize] FAIL: the runner under TSan (exit $rc; log: build-tsan/run.log)" >&2
