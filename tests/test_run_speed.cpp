@@ -189,6 +189,28 @@ TEST(SharedPrecompute, TwoWorkersComputeEachPrecomputeOnce) {
     EXPECT_EQ(computed, 2);
 }
 
+// The session keeps its kCachedEntries most recently used entries (a nightly kept every precompute to
+// its end): the oldest use goes first, a use counts as recent, an entry a render still holds lives on.
+TEST(SharedPrecompute, SessionKeepsTheMostRecentlyUsedEntries) {
+    GpuSession gpu;
+    const size_t n = GpuSession::kCachedEntries;
+    ASSERT_GE(n, 2u);
+    for (size_t i = 0; i < n; ++i) gpu.store("k" + std::to_string(i), std::make_shared<int>(int(i)));
+    std::shared_ptr<int> held = gpu.cached<int>("k1");
+    for (size_t i = 0; i < n; ++i) // every other entry used after it: k1 is now the oldest use
+        if (i != 1) {
+            ASSERT_TRUE(gpu.cached<int>("k" + std::to_string(i)));
+        }
+    gpu.store("new", std::make_shared<int>(99));
+    EXPECT_FALSE(gpu.cached<int>("k1"));
+    EXPECT_EQ(*held, 1); // still the holder's
+    for (const std::string key : {"k0", "new"}) EXPECT_TRUE(gpu.cached<int>(key)) << key;
+    for (size_t i = 2; i < n; ++i) EXPECT_TRUE(gpu.cached<int>("k" + std::to_string(i))) << i;
+    gpu.store("k0", std::make_shared<int>(7)); // replacing an entry evicts nothing
+    EXPECT_EQ(*gpu.cached<int>("k0"), 7);
+    for (size_t i = 2; i < n; ++i) EXPECT_TRUE(gpu.cached<int>("k" + std::to_string(i))) << i;
+}
+
 namespace {
 
 // A render of `spec` with a fresh renderer (no session cache) and the precompute store at `store`

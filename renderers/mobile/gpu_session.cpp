@@ -55,4 +55,14 @@ const vk::GraphicsPipeline& GpuSession::graphics_pipeline(const std::string& ver
     return *graphics_pipelines_.emplace(key, std::move(p)).first->second;
 }
 
+void GpuSession::store(const std::string& key, std::shared_ptr<void> value) {
+    cache_[key] = {std::move(value), ++uses_};
+    while (cache_.size() > kCachedEntries) {
+        auto oldest = cache_.begin();
+        for (auto it = cache_.begin(); it != cache_.end(); ++it)
+            if (it->second.last_use < oldest->second.last_use) oldest = it;
+        cache_.erase(oldest); // a render still holding it keeps it alive (shared_ptr)
+    }
+}
+
 } // namespace iblcheck

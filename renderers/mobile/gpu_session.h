@@ -2,6 +2,7 @@
 // pipelines, cached by shader name + defines (creating a pipeline makes lavapipe compile LLVM,
 // ~0.1 s each).
 #pragma once
+#include <cstdint>
 #include <map>
 #include <memory>
 #include <string>
@@ -30,11 +31,17 @@ class GpuSession {
                                                   const vk::CompileOptions& options = {});
     // A per-session cache of anything built on the device (the precompute passes' results, keyed by
     // environment hash + settings): an animated sequence re-renders the same environment per frame.
+    // It keeps the kCachedEntries most recently used: the runner gives a worker the tests that share a
+    // precompute one after another, and a nightly kept all 120 of its precomputes (a 512 cube, a
+    // 4096-sample prefilter...) to its end, 1.1-1.2 GB at its peak (issue 33).
+    static constexpr size_t kCachedEntries = 4;
     template <class T> std::shared_ptr<T> cached(const std::string& key) {
         auto it = cache_.find(key);
-        return it == cache_.end() ? nullptr : std::static_pointer_cast<T>(it->second);
+        if (it == cache_.end()) return nullptr;
+        it->second.last_use = ++uses_;
+        return std::static_pointer_cast<T>(it->second.value);
     }
-    void store(const std::string& key, std::shared_ptr<void> value) { cache_[key] = std::move(value); }
+    void store(const std::string& key, std::shared_ptr<void> value);
 
     // Hash of the sources each pipeline was compiled from, for provenance.
     const std::map<std::string, std::string>& shader_hashes() const { return shader_hashes_; }
@@ -44,7 +51,12 @@ class GpuSession {
     std::map<std::string, std::unique_ptr<vk::ComputePipeline>> pipelines_;
     std::map<std::string, std::unique_ptr<vk::GraphicsPipeline>> graphics_pipelines_;
     std::map<std::string, std::string> shader_hashes_;
-    std::map<std::string, std::shared_ptr<void>> cache_;
+    struct CacheEntry {
+        std::shared_ptr<void> value;
+        uint64_t last_use = 0;
+    };
+    std::map<std::string, CacheEntry> cache_;
+    uint64_t uses_ = 0;
 };
 
 } // namespace iblcheck
