@@ -32,7 +32,7 @@ class GpuSession {
     // A per-session cache of anything built on the device (the precompute passes' results, keyed by
     // environment hash + settings): an animated sequence re-renders the same environment per frame.
     // It keeps the kCachedEntries most recently used: the runner gives a worker the tests that share a
-    // precompute one after another, and a nightly kept all 120 of its precomputes (a 512 cube, a
+    // precompute one after another, and a nightly kept all 133 of its precomputes (a 512 cube, a
     // 4096-sample prefilter...) to its end, 1.1-1.2 GB at its peak (issue 33).
     static constexpr size_t kCachedEntries = 4;
     template <class T> std::shared_ptr<T> cached(const std::string& key) {
