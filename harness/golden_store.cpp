@@ -6,6 +6,8 @@
 #include <cstring>
 #include <ctime>
 #include <fstream>
+#include <map>
+#include <mutex>
 #include <set>
 #include <sstream>
 
@@ -181,10 +183,46 @@ std::optional<Golden> GoldenStore::reference_sequence(const TestSpec& spec, int 
     return g;
 }
 
+namespace {
+// A file's identity for the reference cache: its size and modification time (the golden writer renames
+// a new file over the old, so a rewritten golden has a new time).
+std::string file_stamp(const fs::path& p) {
+    std::error_code ec;
+    const auto size = fs::file_size(p, ec);
+    const auto time = fs::last_write_time(p, ec).time_since_epoch().count();
+    return ec ? std::string("?") : std::to_string(size) + "@" + std::to_string(time);
+}
+
+// The truth goldens a process has read, by path and the stamps of the EXR and its sidecar: a truth is
+// the reference of many tests (the ci suite read the roughness sweep's two 43 times, 9 % of a warm
+// run's worker time, issue 33). A few are kept; each caller gets its own copy of the pixels.
+Golden load_reference(const fs::path& exr) {
+    static std::mutex mutex;
+    static std::map<std::string, Golden> loaded;
+    const std::string key =
+        fs::absolute(exr).string() + "|" + file_stamp(exr) + "|" + file_stamp(fs::path(exr).replace_extension(".json"));
+    {
+        std::lock_guard lock(mutex);
+        if (auto it = loaded.find(key); it != loaded.end()) {
+            Golden g = it->second;
+            g.image = g.image.clone();
+            return g;
+        }
+    }
+    Golden g = load_golden(exr, "");
+    std::lock_guard lock(mutex);
+    if (loaded.size() >= 8) loaded.clear();
+    Golden kept = g;
+    kept.image = g.image.clone();
+    loaded.emplace(key, std::move(kept));
+    return g;
+}
+} // namespace
+
 std::optional<Golden> GoldenStore::reference(const TestSpec& spec) const {
     fs::path p = reference_path(spec);
     if (!fs::exists(p)) return std::nullopt;
-    return load_golden(p, "");
+    return load_reference(p);
 }
 
 void GoldenStore::write_sidecar(const fs::path& exr, const json& provenance) {

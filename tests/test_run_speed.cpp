@@ -16,6 +16,7 @@
 #include <set>
 #include <string>
 
+#include "harness/golden_store.h"
 #include "harness/metrics_store.h"
 #include "harness/runner.h"
 #include "harness/suite.h"
@@ -495,6 +496,34 @@ TEST(MetricsStore, AStoredComparisonIsTheComputedOneAndAChangedInputMisses) {
     EXPECT_NE(metrics_store_key(golden, test, &aces, "build A"), key);
     EXPECT_NE(metrics_store_key(golden, test, &aces, "build A"), metrics_store_key(golden, test, &neutral, "build A"));
     EXPECT_NE(metrics_store_key(golden, test, nullptr, "build B"), key);
+}
+
+// A truth read once is kept for the tests after (issue 33), and what the key holds keeps it right: a
+// truth rewritten by the golden writer (new pixels, or a new sidecar) is read again, and each reader
+// gets its own copy of the pixels.
+TEST(GoldenStore, AReferenceRewrittenDuringARunIsReadAgain) {
+    const fs::path dir = temp_dir("reference_cache");
+    const GoldenStore store(dir);
+    TestSpec spec;
+    spec.scene = "furnace";
+    spec.method = "mobile";
+    spec.env = "constant:1";
+    const fs::path exr = store.reference_path(spec);
+    fs::create_directories(exr.parent_path());
+    cv::Mat a(16, 24, CV_32FC3), b;
+    cv::randu(a, 0.0f, 2.0f);
+    b = a * 0.5f;
+    GoldenStore::write_golden(exr, a, {{"source", "a"}});
+    std::optional<Golden> first = store.reference(spec);
+    ASSERT_TRUE(first.has_value());
+    EXPECT_EQ(cv::norm(first->image, a, cv::NORM_INF), 0.0);
+    first->image.setTo(0); // the reader's copy
+    EXPECT_EQ(cv::norm(store.reference(spec)->image, a, cv::NORM_INF), 0.0);
+    GoldenStore::write_golden(exr, b, {{"source", "a"}});
+    EXPECT_EQ(cv::norm(store.reference(spec)->image, b, cv::NORM_INF), 0.0);
+    GoldenStore::write_golden(exr, b, {{"source", "b"}}); // the same pixels, a new sidecar
+    EXPECT_EQ(store.reference(spec)->provenance.value("source", ""), "b");
+    fs::remove_all(dir);
 }
 
 namespace {
