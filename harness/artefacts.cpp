@@ -1,8 +1,13 @@
 #include "artefacts.h"
 
+#include <map>
+#include <mutex>
+#include <optional>
+
 #include "golden_store.h"
 #include "image_io/image_io.h"
 #include "kernel/atomic_file.h"
+#include "kernel/hash.h"
 #include "kernel/profile.h"
 #include "metrics/display_transform.h"
 #include "sphere_errors.h"
@@ -12,6 +17,17 @@ using nlohmann::json;
 
 namespace iblcheck {
 
+namespace {
+std::mutex& drawn_mutex() {
+    static std::mutex m;
+    return m;
+}
+std::map<std::string, fs::path>& drawn() {
+    static std::map<std::string, fs::path> files;
+    return files;
+}
+} // namespace
+
 Artefacts Artefacts::for_test(const fs::path& out_dir, const std::string& test) {
     if (out_dir.empty()) return {};
     return {out_dir / "images" / safe_file_name(test), "images/" + safe_file_name(test) + "/"};
@@ -19,10 +35,42 @@ Artefacts Artefacts::for_test(const fs::path& out_dir, const std::string& test) 
 
 std::string Artefacts::exr(const std::string& png) { return png.substr(0, png.rfind('.')) + ".exr"; }
 
+namespace {
+// A content hash of a float image (size, type, pixels).
+std::string pixels_hash(const cv::Mat& m) {
+    Fnv1a64 h;
+    h.update(std::to_string(m.cols) + "x" + std::to_string(m.rows) + ":" + std::to_string(m.type()) + ";");
+    const size_t row = size_t(m.cols) * m.elemSize();
+    for (int y = 0; y < m.rows; ++y) h.update(m.ptr(y), row);
+    return h.hex();
+}
+
+// The PNGs of a run's pictures already written, by their pixels' hash: a baseline equal to the render
+// is the render's picture, and a truth is the reference of many tests (issue 33: the ci suite drew the
+// sweep's two truths 43 times). Another is copied from the first file instead of drawn again.
+std::optional<fs::path> drawn_png(const std::string& hash) {
+    std::lock_guard lock(drawn_mutex());
+    auto it = drawn().find(hash);
+    if (it == drawn().end()) return std::nullopt;
+    std::error_code ec;
+    if (!fs::is_regular_file(it->second, ec)) return std::nullopt; // an earlier run's folder, gone
+    return it->second;
+}
+} // namespace
+
 std::string Artefacts::png(const std::string& name, const cv::Mat& linear, bool with_exr) const {
     ProfileStage stage("files");
     fs::create_directories(dir);
-    write_png((dir / name).string(), display_transform(linear));
+    const fs::path file = dir / name;
+    const std::string hash = pixels_hash(linear);
+    std::error_code ec;
+    const std::optional<fs::path> earlier = drawn_png(hash);
+    if (!earlier || !fs::copy_file(*earlier, file, fs::copy_options::overwrite_existing, ec) || ec) {
+        write_png(file.string(), display_transform(linear));
+        std::lock_guard lock(drawn_mutex());
+        if (drawn().size() >= 64) drawn().clear();
+        drawn()[hash] = file;
+    }
     if (with_exr) write_exr_half((dir / exr(name)).string(), linear);
     return rel + name;
 }

@@ -16,13 +16,16 @@
 #include <set>
 #include <string>
 
+#include "harness/artefacts.h"
 #include "harness/golden_store.h"
 #include "harness/metrics_store.h"
 #include "harness/runner.h"
 #include "harness/suite.h"
+#include "image_io/image_io.h"
 #include "kernel/hash.h"
 #include "kernel/profile.h"
 #include "kernel/program.h"
+#include "metrics/display_transform.h"
 #include "renderers/environments/environment.h"
 #include "renderers/mobile/cost_store.h"
 #include "renderers/mobile/precompute_store.h"
@@ -523,6 +526,30 @@ TEST(GoldenStore, AReferenceRewrittenDuringARunIsReadAgain) {
     EXPECT_EQ(cv::norm(store.reference(spec)->image, b, cv::NORM_INF), 0.0);
     GoldenStore::write_golden(exr, b, {{"source", "b"}}); // the same pixels, a new sidecar
     EXPECT_EQ(store.reference(spec)->provenance.value("source", ""), "b");
+    fs::remove_all(dir);
+}
+
+// A picture the run already drew (a baseline equal to its render, a truth shared by many tests) is
+// copied, not drawn again (issue 33): the same bytes as drawing it; other pixels are drawn; a first
+// file that is gone is drawn again.
+TEST(RunFiles, APictureAlreadyDrawnIsCopiedWithTheSameBytes) {
+    const fs::path dir = temp_dir("drawn_png");
+    const Artefacts one = Artefacts::for_test(dir, "one"), two = Artefacts::for_test(dir, "two");
+    cv::Mat a(20, 30, CV_32FC3), b;
+    cv::randu(a, 0.0f, 3.0f);
+    b = a.clone();
+    b.at<cv::Vec3f>(19, 29)[1] += 0.25f;
+    EXPECT_EQ(one.png("test.png", a, false), "images/one/test.png");
+    two.png("baseline.png", a, false);
+    two.png("other.png", b, false);
+    write_png((dir / "fresh_b.png").string(), display_transform(b));
+    EXPECT_EQ(read_text(dir / "images/two/baseline.png"), read_text(dir / "images/one/test.png"));
+    EXPECT_EQ(read_text(dir / "images/two/other.png"), read_text(dir / "fresh_b.png"));
+    EXPECT_NE(read_text(dir / "images/two/other.png"), read_text(dir / "images/one/test.png"));
+    const std::string drawn_a = read_text(dir / "images/one/test.png");
+    fs::remove_all(dir / "images");
+    two.png("again.png", a, false);
+    EXPECT_EQ(read_text(dir / "images/two/again.png"), drawn_a);
     fs::remove_all(dir);
 }
 
