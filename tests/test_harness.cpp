@@ -351,11 +351,10 @@ TEST(Gate, ShaderChangeFailsExactlyTheAffectedCiTestsAndBisectFollowsTheContract
               std::string::npos)
         << out;
 
-    // Without the change the suite passes again.
-    rc = run_command(iblcheck_bin() + " run --suite ci -q", out);
-    EXPECT_EQ(rc, 0) << out;
-
-    // git bisect run: 0 good, 1 bad, 125 when the shaders do not compile.
+    // git bisect run: 0 good, 1 bad, 125 when the shaders do not compile. The good step is the check
+    // that without the change the test passes again; the whole unchanged suite passing is what the
+    // suite.* tests (one a ci test), portability.* and goldens.bless_dry_run_changes_nothing of the
+    // same CTest run check, so this test no longer runs it once more (issue 33).
     const std::string filter = " bisect --filter 'mobile.roughness_sweep.studio.default'";
     EXPECT_EQ(run_command(iblcheck_bin() + filter, out), 0) << out;
     EXPECT_EQ(run_command(env + iblcheck_bin() + filter, out), 1) << out;

@@ -113,7 +113,11 @@ TEST(ReferenceIntegrator, WindowedEnvSamplingIsUnbiasedAndLessNoisy) {
         }
     // The sun's highlight on a r = 0.2 metal sphere: the 5e4 sun must not be lost by a window. Heavy-tailed
     // at low spp (at 1024 spp on 16 px spheres four seeds scattered by ±3 %), so 16384 spp on 32x32.
+    // silhouette_boost = 1 halves these two renders (issue 33): the 608 fully covered pixels keep their
+    // bits (the boost raises only partly covered pixels' counts, mc_adaptive.h), and the 116 silhouette
+    // pixels moved the image mean by < 1e-6 relative (R 4.02079 global, 4.02336 vs 4.02335 window).
     TestSpec sun = reference_spec("sphere", "sky_sun", 16384, 32, 32);
+    sun.options.set("silhouette_boost", "1");
     sun.options.set("roughness", "0.2");
     sun.options.set("metallic", "1");
     sun.options.set("env_sampling", "global");
