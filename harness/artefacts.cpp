@@ -5,9 +5,9 @@
 #include <optional>
 
 #include "golden_store.h"
+#include "image_io/image_hash.h"
 #include "image_io/image_io.h"
 #include "kernel/atomic_file.h"
-#include "kernel/hash.h"
 #include "kernel/profile.h"
 #include "metrics/display_transform.h"
 #include "sphere_errors.h"
@@ -36,15 +36,6 @@ Artefacts Artefacts::for_test(const fs::path& out_dir, const std::string& test) 
 std::string Artefacts::exr(const std::string& png) { return png.substr(0, png.rfind('.')) + ".exr"; }
 
 namespace {
-// A content hash of a float image (size, type, pixels).
-std::string pixels_hash(const cv::Mat& m) {
-    Fnv1a64 h;
-    h.update(std::to_string(m.cols) + "x" + std::to_string(m.rows) + ":" + std::to_string(m.type()) + ";");
-    const size_t row = size_t(m.cols) * m.elemSize();
-    for (int y = 0; y < m.rows; ++y) h.update(m.ptr(y), row);
-    return h.hex();
-}
-
 // The PNGs of a run's pictures already written, by their pixels' hash: a baseline equal to the render
 // is the render's picture, and a truth is the reference of many tests (issue 33: the ci suite drew the
 // sweep's two truths 43 times). Another is copied from the first file instead of drawn again.
@@ -62,7 +53,7 @@ std::string Artefacts::png(const std::string& name, const cv::Mat& linear, bool 
     ProfileStage stage("files");
     fs::create_directories(dir);
     const fs::path file = dir / name;
-    const std::string hash = pixels_hash(linear);
+    const std::string hash = image_hash(linear);
     std::error_code ec;
     const std::optional<fs::path> earlier = drawn_png(hash);
     if (!earlier || !fs::copy_file(*earlier, file, fs::copy_options::overwrite_existing, ec) || ec) {

@@ -4,6 +4,7 @@
 #include <cstring>
 #include <fstream>
 
+#include "image_io/image_hash.h"
 #include "kernel/atomic_file.h"
 #include "kernel/hash.h"
 #include "renderers/vulkan/shader_compiler.h"
@@ -30,12 +31,6 @@ double double_of(const json& j) {
     double v = 0;
     std::memcpy(&v, &b, sizeof v);
     return v;
-}
-
-void hash_image(Fnv1a64& h, const cv::Mat& m) {
-    h.update(std::to_string(m.cols) + "x" + std::to_string(m.rows) + ":" + std::to_string(m.type()) + ";");
-    const size_t row_bytes = size_t(m.cols) * m.elemSize();
-    for (int y = 0; y < m.rows; ++y) h.update(m.ptr(y), row_bytes);
 }
 
 // Every figure of a FlipResult but its map (stored after the header, raw).
