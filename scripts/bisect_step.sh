@@ -7,6 +7,7 @@
 #   git bisect run scripts/bisect_step.sh --goldens /tmp/goldens-good --filter 'mobile.roughness_sweep.*'
 set -uo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
+source "$root/scripts/cmake_env.sh"
 cmake -S "$root" -B "$root/build" -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null 2>&1 || exit 125
 cmake --build "$root/build" -j"$(nproc)" --target iblcheck >/dev/null 2>&1 || exit 125
 exec "$root/build/iblcheck" bisect "$@"

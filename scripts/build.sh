@@ -6,6 +6,7 @@
 # wait for them.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
+source "$root/scripts/cmake_env.sh"
 target=(--target iblcheck)
 case "${1:-}" in
   --all) target=() ;;

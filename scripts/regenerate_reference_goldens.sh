@@ -19,6 +19,7 @@
 # Expected time (EXPECTED_TIME below, measured on this project's 2-core machine, see CONVERGENCE.md).
 set -euo pipefail
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
+source "$ROOT/scripts/cmake_env.sh"
 BUILD_DIR=${BUILD_DIR:-$ROOT/build}
 TEMPORAL=${TEMPORAL:-0}
 LIST=${LIST:-0}

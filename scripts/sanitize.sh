@@ -9,6 +9,7 @@ set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 if [[ "${IBLCHECK_NO_SANITIZERS:-0}" == 1 ]]; then echo "[sanitize] skipped (IBLCHECK_NO_SANITIZERS=1)"; exit 0; fi
 jobs="$(nproc)"
+source "$root/scripts/cmake_env.sh"
 asan_tests=(test_verdict test_metrics_flip test_metrics_ssim_psnr test_scenes_environments)
 
 echo "[sanitize] ASan+UBSan build of ${asan_tests[*]}"

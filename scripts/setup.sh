@@ -18,9 +18,10 @@ PACKAGES=(
   xz-utils zlib1g-dev
 )
 # Optional, for build speed (the build works without them, cmake/build_speed.cmake): ccache caches
-# compiles across rebuilds and bisect steps, lld links ~3x faster than gold/ld. Set
+# compiles across rebuilds and bisect steps, lld links ~3x faster than gold/ld, Ninja builds several
+# targets at once where Make builds them one by one (scripts/cmake_env.sh). Set
 # IBLCHECK_NO_BUILD_TOOLS=1 to skip them.
-if [[ "${IBLCHECK_NO_BUILD_TOOLS:-0}" != 1 ]]; then PACKAGES+=(ccache lld); fi
+if [[ "${IBLCHECK_NO_BUILD_TOOLS:-0}" != 1 ]]; then PACKAGES+=(ccache lld ninja-build); fi
 # Optional: the report's browser test runs where chromium is present; set IBLCHECK_NO_CHROMIUM=1 to skip it.
 if [[ "${IBLCHECK_NO_CHROMIUM:-0}" != 1 ]]; then PACKAGES+=(chromium); fi
 
