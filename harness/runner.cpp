@@ -143,10 +143,12 @@ void check_output_options(const RunOptions& o, const Suite& suite) {
 std::vector<std::vector<size_t>> precompute_batches(const std::vector<TestCase>& tests) {
     std::vector<std::vector<size_t>> batches;
     std::map<std::string, size_t> batch_of;
+    std::vector<std::string> full(tests.size());
     for (size_t i = 0; i < tests.size(); ++i) {
         std::string key;
         try {
-            key = precompute_share_key(tests[i].spec);
+            key = radiance_chain_share_key(tests[i].spec);
+            full[i] = precompute_share_key(tests[i].spec);
         } catch (const std::exception&) {
             key = "unshared;" + std::to_string(i);
         }
@@ -154,6 +156,13 @@ std::vector<std::vector<size_t>> precompute_batches(const std::vector<TestCase>&
         auto [it, fresh] = batch_of.emplace(key, batches.size());
         if (fresh) batches.emplace_back();
         batches[it->second].push_back(i);
+    }
+    // Within a chain's batch, the tests of one precompute back to back (in suite order otherwise), so
+    // the session's few cached entries hold each while its tests run.
+    for (auto& b : batches) {
+        std::map<std::string, size_t> first;
+        for (size_t i : b) first.emplace(full[i], first.size());
+        std::stable_sort(b.begin(), b.end(), [&](size_t x, size_t y) { return first.at(full[x]) < first.at(full[y]); });
     }
     std::stable_sort(batches.begin(), batches.end(), [](const auto& a, const auto& b) { return a.size() > b.size(); });
     return batches;

@@ -53,8 +53,9 @@ RunSummary run_suite(const RunOptions& options);
 // `o` with --history set to the suite's history file beside --out (Suite::history) when the run
 // names no --history and has an --out; otherwise `o` unchanged.
 RunOptions with_suite_history(RunOptions o, const Suite& suite);
-// `tests` (indices) in batches that share a GPU precompute (renderer.h: precompute_share_key),
-// largest first: a worker takes a whole batch, so its session computes that precompute once.
+// `tests` (indices) in batches that share a radiance chain (renderer.h: radiance_chain_share_key),
+// largest first, each batch's tests of one precompute (precompute_share_key) back to back: a worker
+// takes a whole batch, so its session computes that chain once and each precompute once.
 // Handed out a test at a time, the two workers each computed most of them (the 71 ci tests: ~47
 // precomputes where 30 differ). A test whose options are bad gets a batch of its own (it fails
 // when it runs), and so does each CPU-truth test (nothing to share).

@@ -74,6 +74,12 @@ std::string precompute_share_key(const TestSpec& spec) {
     return "";
 }
 
+std::string radiance_chain_share_key(const TestSpec& spec) {
+    if (spec.method == "mobile") return precompute_key(spec.env, chain_settings(mobile_precompute_settings(spec)));
+    if (spec.method == "sampled") return precompute_key(spec.env, chain_settings(sampled_precompute_settings(spec)));
+    return "";
+}
+
 Renderer::Renderer(vk::ContextOptions options) : options_(std::move(options)) {}
 Renderer::~Renderer() = default;
 

@@ -25,9 +25,13 @@ std::vector<MethodInfo> method_catalog();
 void validate_spec(const TestSpec& spec);
 
 // Which GPU precompute a render of `spec` needs (environment spec + settings; empty for the CPU
-// truth): the runner gives tests with the same key to the same worker, whose session computes it
-// once. Throws UsageError on a bad option, as render() would.
+// truth). Throws UsageError on a bad option, as render() would.
 std::string precompute_share_key(const TestSpec& spec);
+// Which radiance chain that precompute is derived from (ibl_precompute.h chain_settings: the
+// variants that differ only in storage, the DFG table or the irradiance cube share one; empty for
+// the CPU truth): the runner gives tests with the same chain to the same worker, whose session
+// computes the chain once and each precompute once.
+std::string radiance_chain_share_key(const TestSpec& spec);
 
 class Renderer {
   public:

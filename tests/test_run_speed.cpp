@@ -128,10 +128,12 @@ TEST(Profile, RunPrintsStagesAndEachTestRecordsThem) {
     EXPECT_FALSE(plain.results["tests"][0].contains("profile"));
 }
 
-// The ci suite's tests in batches that share a precompute: every test once, one key per batch and
-// no key in two batches; the options that only change the shading (dominant_dir, normalization,
-// shading=fragment, another scene) share the default's batch, a storage or mip curve does not.
-TEST(SharedPrecompute, CiTestsAreBatchedByTheirPrecompute) {
+// The ci suite's tests in batches that share a radiance chain: every test once, one chain per batch
+// and no chain in two batches, each precompute's tests back to back. The options that only change
+// the shading (dominant_dir, normalization, shading=fragment, another scene) or only how the chain is
+// stored or what is added to it (storage, env_brdf=lut, diffuse=irradiance_cube) share the default's
+// batch; a mip curve, a layout or another environment does not.
+TEST(SharedPrecompute, CiTestsAreBatchedByTheirRadianceChain) {
     const std::vector<TestCase> tests = load_suite("ci").tests;
     const auto batches = precompute_batches(tests);
     std::set<size_t> seen;
@@ -139,11 +141,18 @@ TEST(SharedPrecompute, CiTestsAreBatchedByTheirPrecompute) {
     std::map<std::string, size_t> batch_of;
     for (size_t b = 0; b < batches.size(); ++b) {
         ASSERT_FALSE(batches[b].empty());
-        const std::string key = precompute_share_key(tests[batches[b][0]].spec);
+        const std::string key = radiance_chain_share_key(tests[batches[b][0]].spec);
         EXPECT_TRUE(keys.insert(key).second) << "two batches share " << key;
+        std::set<std::string> started; // this batch's precomputes so far: each one's tests come together
+        std::string current;
         for (size_t i : batches[b]) {
             EXPECT_TRUE(seen.insert(i).second) << tests[i].name << " in two batches";
-            EXPECT_EQ(precompute_share_key(tests[i].spec), key) << tests[i].name;
+            EXPECT_EQ(radiance_chain_share_key(tests[i].spec), key) << tests[i].name;
+            const std::string full = precompute_share_key(tests[i].spec);
+            if (full != current) {
+                EXPECT_TRUE(started.insert(full).second) << tests[i].name << ": its precompute's tests are split";
+                current = full;
+            }
             batch_of[tests[i].name] = b;
         }
         if (b > 0) {
@@ -154,12 +163,17 @@ TEST(SharedPrecompute, CiTestsAreBatchedByTheirPrecompute) {
     const size_t studio = batch_of.at("mobile.roughness_sweep.studio.default");
     for (const char* same :
          {"mobile.roughness_sweep.studio.dominant_dir=lagarde", "mobile.roughness_sweep.studio.normalization=ue4",
-          "mobile.roughness_sweep.studio.shading=fragment", "mobile.sphere.studio.default"})
+          "mobile.roughness_sweep.studio.shading=fragment", "mobile.sphere.studio.default",
+          "mobile.roughness_sweep.studio.storage=rgbm8", "mobile.roughness_sweep.studio.storage=astc_hdr",
+          "mobile.roughness_sweep.studio.env_brdf=lut", "mobile.roughness_sweep.studio.diffuse=irradiance_cube"})
         EXPECT_EQ(batch_of.at(same), studio) << same;
-    for (const char* other : {"mobile.roughness_sweep.studio.storage=rgbm8", "mobile.roughness_sweep.studio.mip_mapping=origin",
-                              "mobile.roughness_sweep.sky_sun.default", "sampled.roughness_sweep.studio.samples=64"})
+    for (const char* other :
+         {"mobile.roughness_sweep.studio.mip_mapping=origin", "mobile.roughness_sweep.studio.env_layout=octahedral",
+          "mobile.roughness_sweep.sky_sun.default", "sampled.roughness_sweep.studio.samples=64"})
         EXPECT_NE(batch_of.at(other), studio) << other;
-    EXPECT_LT(batches.size(), tests.size()); // the sharing is real (71 tests, 35 precomputes on 2026-11-26)
+    EXPECT_NE(precompute_share_key(tests[batches[studio][0]].spec),
+              precompute_share_key(tests[batches[studio].back()].spec)); // one chain, several precomputes
+    EXPECT_LT(batches.size(), tests.size());
 }
 
 // Two workers on tests that interleave two precomputes, the first two tests sharing one: each is
@@ -242,6 +256,38 @@ TestSpec furnace_spec(const std::map<std::string, std::string>& options) {
 }
 
 } // namespace
+
+// Variants that differ only in how the prefiltered chain is stored, or in what is added to it (the
+// DFG table, the irradiance cube), share one radiance chain in a session: its passes are measured
+// once, so each variant reports the very timings of the first (a chain computed again is timed
+// again), and each renders bit for bit as a session that computed the chain for it alone
+// (encode_storage.comp: encoding the stored max(result, 0) is encoding the result).
+TEST(SharedPrecompute, VariantsOfOneChainShareItAndRenderAsIfAlone) {
+    auto prefilter_ms = [](const RenderResult& r) {
+        for (const PassTiming& t : r.timings)
+            if (t.name == "prefilter_ggx") return t.ms;
+        return -1.0;
+    };
+    setenv("IBLCHECK_PRECOMPUTE_CACHE", "0", 1);
+    Renderer shared;
+    const RenderResult first = shared.render(furnace_spec({}));
+    ASSERT_GT(prefilter_ms(first), 0.0);
+    for (const auto& options : std::vector<std::map<std::string, std::string>>{{{"storage", "rgbm8"}},
+                                                                               {{"storage", "r11g11b10"}},
+                                                                               {{"storage", "rgba32f"}},
+                                                                               {{"storage", "astc_ldr_rgbm"}},
+                                                                               {{"env_brdf", "lut"}},
+                                                                               {{"diffuse", "irradiance_cube"}}}) {
+        const TestSpec spec = furnace_spec(options);
+        const std::string what = spec.options.canonical();
+        setenv("IBLCHECK_PRECOMPUTE_CACHE", "0", 1); // fresh_render unsets it
+        const RenderResult r = shared.render(spec);
+        EXPECT_FALSE(r.provenance["precompute_cached"].get<bool>()) << what; // its own precompute...
+        EXPECT_EQ(prefilter_ms(r), prefilter_ms(first)) << what;             // ...from the shared chain
+        EXPECT_TRUE(same_pixels(r.image, fresh_render(spec, "0").image)) << what;
+    }
+    unsetenv("IBLCHECK_PRECOMPUTE_CACHE");
+}
 
 // A precompute stored on disk renders bit-identically to one computed now, for every storage format
 // the store holds (RGBA16F, RGBM8, R11G11B10, ASTC's decoded texels), a 2D layout, the LUT and the

@@ -150,8 +150,9 @@ EquirectUpload stage_equirect(vk::Context& ctx, const cv::Mat& eq) {
     return up;
 }
 
-// The images and buffers the passes write. A pass that is off gets a 1×1 placeholder so the
-// shading pass's descriptor set is the same shape for every variant.
+// The images and buffers the derived passes write (the source cube and SH9 are the radiance chain's,
+// copied in). A pass that is off gets a 1×1 placeholder so the shading pass's descriptor set is the
+// same shape for every variant.
 void allocate_outputs(vk::Context& ctx, const PrecomputeSettings& s, EnvLayout layout, const LayoutExtent& extent, uint32_t mips,
                       IblResources& r) {
     r.source_cube = ctx.create_image(VK_FORMAT_R32G32B32A32_SFLOAT, s.cube_size, s.cube_size, r.full_mips, true);
@@ -191,12 +192,47 @@ struct Recording {
 
 void record_upload(const Recording& rec, const EquirectUpload& up) {
     vk::Context& ctx = rec.ctx;
-    IblResources& r = rec.r;
     ctx.transition(rec.cmd, up.image, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
     ctx.copy_buffer_to_image(rec.cmd, up.staging, up.image);
     ctx.transition(rec.cmd, up.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL);
+}
+
+// The images the passes write, from UNDEFINED to GENERAL (the layout every pass uses).
+void record_outputs_general(const Recording& rec) {
+    IblResources& r = rec.r;
     for (vk::Image* img : {&r.source_cube, &r.prefiltered, &r.lut, &r.irradiance})
-        ctx.transition(rec.cmd, *img, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL);
+        rec.ctx.transition(rec.cmd, *img, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL);
+}
+
+// Every level and layer of `src` into `dst` (same format and shape; both in GENERAL).
+void record_copy_image(const Recording& rec, const vk::Image& src, const vk::Image& dst) {
+    std::vector<VkImageCopy> regions(src.mips);
+    for (uint32_t m = 0; m < src.mips; ++m) {
+        VkImageCopy& c = regions[m];
+        c.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, m, 0, src.layers};
+        c.dstSubresource = c.srcSubresource;
+        c.extent = {std::max(1u, src.width >> m), std::max(1u, src.height >> m), 1};
+    }
+    vkCmdCopyImage(rec.cmd, src.image, VK_IMAGE_LAYOUT_GENERAL, dst.image, VK_IMAGE_LAYOUT_GENERAL, uint32_t(regions.size()),
+                   regions.data());
+    rec.ctx.barrier(rec.cmd);
+}
+
+// The rgba32f chain in the storage format, level by level (encode_storage.comp).
+void record_encode_storage(const Recording& rec, const vk::ComputePipeline& p, const vk::Image& chain,
+                           const LayoutExtent& extent, uint32_t mips) {
+    for (uint32_t m = 0; m < mips; ++m) {
+        const EncodeStoragePush pe{std::max(1u, extent.width >> m), std::max(1u, extent.height >> m)};
+        const std::vector<vk::Binding> b = {vk::Binding::storage_image(0, chain.storage_views[m]),
+                                            vk::Binding::storage_image(1, rec.r.prefiltered.storage_views[m])};
+        if (m == 0) {
+            p.warm_up(rec.cmd, b, &pe, sizeof pe);
+            rec.timer.begin(rec.cmd, "encode_storage");
+        }
+        p.dispatch(rec.cmd, b, &pe, sizeof pe, groups(pe.width), groups(pe.height), extent.layers);
+    }
+    rec.timer.end(rec.cmd);
+    rec.ctx.barrier(rec.cmd);
 }
 
 // Equirect → cube mip 0, supersampled so each cube texel averages the equirect pixels it covers.
@@ -310,6 +346,78 @@ void record_irradiance(const Recording& rec) {
 
 } // namespace
 
+// The radiance chain: the source cube's box pyramid, its SH9 and the GGX-prefiltered chain in
+// rgba32f (prefilter_ggx.comp with storage=rgba32f), computed once per environment and chain geometry
+// (size, levels, samples, mip_mapping, env_layout, rotation) and shared by every variant that only
+// stores it differently, or adds the DFG table or the irradiance cube. In the ci suite 33 of the 51
+// precomputes were such variants, each paying its own prefilter (~1.6 s each under lavapipe with
+// GALLIUM_OVERRIDE_CPU_CAPS=sse4.1: the portability run's largest stage; issue 33).
+PrecomputeSettings chain_settings(const PrecomputeSettings& s) {
+    const PrecomputeSettings defaults;
+    PrecomputeSettings c = s;
+    c.storage = "rgba32f";
+    c.astc_block = defaults.astc_block;
+    c.rgbm_range = defaults.rgbm_range;
+    c.lut = false;
+    c.lut_size = defaults.lut_size;
+    c.lut_samples = defaults.lut_samples;
+    c.irradiance_cube = false;
+    c.irradiance_size = defaults.irradiance_size;
+    return c;
+}
+
+namespace {
+
+IblResources compute_radiance_chain(GpuSession& gpu, const Environment& env, const PrecomputeSettings& c, EnvLayout layout,
+                                    uint32_t mips, std::vector<PassTiming>& timings) {
+    vk::Context& ctx = gpu.ctx();
+    IblResources r;
+    r.full_mips = cubemap_max_mip(c.cube_size) + 1;
+    r.levels = mips;
+    const LayoutExtent extent = layout_extent(layout, c.cube_size);
+    const EquirectUpload equirect = stage_equirect(ctx, env.equirect);
+    allocate_outputs(ctx, c, layout, extent, mips, r);
+    const auto& p_e2c = gpu.pipeline("equirect_to_cube.comp", {}, {kSampled, kStorageImage}, sizeof(EquirectToCubePush));
+    const auto& p_down = gpu.pipeline("downsample_cube.comp", {}, {kStorageImage, kStorageImage}, sizeof(DownsamplePush));
+    const auto& p_sh = gpu.pipeline("sh9_project.comp", {}, {kStorageImage, kStorageBuffer}, sizeof(Sh9Push));
+    const auto& p_pre =
+        gpu.pipeline("prefilter_ggx.comp", storage_defines(c, r), {kSampled, kStorageImage}, sizeof(PrefilterPush));
+    vk::GpuTimer timer(ctx, 8);
+    ctx.submit([&](VkCommandBuffer cmd) {
+        const Recording rec{gpu, ctx, cmd, timer, c, r};
+        timer.reset(cmd);
+        record_upload(rec, equirect);
+        record_outputs_general(rec);
+        record_equirect_to_cube(rec, p_e2c, equirect.image);
+        record_downsample(rec, p_down);
+        if (c.prefiltered) record_prefilter(rec, p_pre, extent, mips);
+        record_sh9(rec, p_sh);
+        ctx.barrier(cmd);
+    });
+    for (auto& [name, ms] : timer.results()) timings.push_back({name, ms, true, true});
+    return r;
+}
+
+struct ChainEntry {
+    IblResources chain;
+    std::vector<PassTiming> timings;
+};
+
+// The radiance chain through the session's cache (the runner gives one worker the tests that share a
+// chain: renderer.h precompute_share_key).
+std::shared_ptr<ChainEntry> radiance_chain(GpuSession& gpu, const Environment& env, const PrecomputeSettings& s,
+                                           EnvLayout layout, uint32_t mips) {
+    const PrecomputeSettings c = chain_settings(s);
+    const std::string key = "chain;" + precompute_key(env.content_hash, c);
+    if (auto e = gpu.cached<ChainEntry>(key)) return e;
+    auto e = std::make_shared<ChainEntry>();
+    e->chain = compute_radiance_chain(gpu, env, c, layout, mips, e->timings);
+    gpu.store(key, e);
+    return e;
+}
+
+} // namespace
+
 IblResources run_precompute(GpuSession& gpu, const Environment& env, const PrecomputeSettings& s,
                             std::vector<PassTiming>& timings) {
     vk::Context& ctx = gpu.ctx();
@@ -324,29 +432,22 @@ IblResources run_precompute(GpuSession& gpu, const Environment& env, const Preco
     r.levels = mips;
     const LayoutExtent extent = layout_extent(layout, s.cube_size);
 
-    const EquirectUpload equirect = stage_equirect(ctx, env.equirect);
+    // The shared passes' timings are this precompute's too: they are what it costs.
+    const std::shared_ptr<ChainEntry> chain = radiance_chain(gpu, env, s, layout, mips);
+    timings.insert(timings.end(), chain->timings.begin(), chain->timings.end());
     allocate_outputs(ctx, s, layout, extent, mips, r);
-
-    const auto& p_e2c = gpu.pipeline("equirect_to_cube.comp", {}, {kSampled, kStorageImage}, sizeof(EquirectToCubePush));
-    const auto& p_down = gpu.pipeline("downsample_cube.comp", {}, {kStorageImage, kStorageImage}, sizeof(DownsamplePush));
-    const auto& p_sh = gpu.pipeline("sh9_project.comp", {}, {kStorageImage, kStorageBuffer}, sizeof(Sh9Push));
-
+    std::memcpy(r.sh.mapped, chain->chain.sh.mapped, size_t(r.sh.size));
+    // RGBM's range comes from the source cube, before the chain is encoded.
+    if (s.prefiltered && is_rgbm(s.storage)) fit_rgbm_range(ctx, chain->chain.source_cube, s.rgbm_range, r);
+    const auto& p_enc =
+        gpu.pipeline("encode_storage.comp", storage_defines(s, r), {kStorageImage, kStorageImage}, sizeof(EncodeStoragePush));
     vk::GpuTimer timer(ctx, 8);
     ctx.submit([&](VkCommandBuffer cmd) {
         const Recording rec{gpu, ctx, cmd, timer, s, r};
         timer.reset(cmd);
-        record_upload(rec, equirect);
-        record_equirect_to_cube(rec, p_e2c, equirect.image);
-        record_downsample(rec, p_down);
-    });
-    // RGBM's range comes from the source cube, so the chain is encoded in a second submission.
-    if (s.prefiltered && is_rgbm(s.storage)) fit_rgbm_range(ctx, r.source_cube, s.rgbm_range, r);
-    const auto& p_pre =
-        gpu.pipeline("prefilter_ggx.comp", storage_defines(s, r), {kSampled, kStorageImage}, sizeof(PrefilterPush));
-    ctx.submit([&](VkCommandBuffer cmd) {
-        const Recording rec{gpu, ctx, cmd, timer, s, r};
-        if (s.prefiltered) record_prefilter(rec, p_pre, extent, mips);
-        record_sh9(rec, p_sh);
+        record_outputs_general(rec);
+        record_copy_image(rec, chain->chain.source_cube, r.source_cube);
+        if (s.prefiltered) record_encode_storage(rec, p_enc, chain->chain.prefiltered, extent, mips);
         if (s.lut) record_dfg_lut(rec);
         if (s.irradiance_cube) record_irradiance(rec);
         ctx.barrier(cmd);

@@ -64,6 +64,12 @@ IblResources run_precompute(GpuSession& gpu, const Environment& env, const Preco
 // grouping before anything is loaded its spec) and every setting.
 std::string precompute_key(const std::string& env_id, const PrecomputeSettings& s);
 
+// The settings of the radiance chain `s` is derived from: the source cube's pyramid, its SH9 and the
+// GGX-prefiltered chain in rgba32f, which every variant differing from `s` only in storage, the DFG
+// table or the irradiance cube shares (run_precompute computes it once per session and encodes it;
+// encode_storage.comp). precompute_key(env, chain_settings(s)) names it.
+PrecomputeSettings chain_settings(const PrecomputeSettings& s);
+
 std::shared_ptr<IblResources> precompute_cached(GpuSession& gpu, const Environment& env, const PrecomputeSettings& s,
                                                 std::vector<PassTiming>& timings, bool& cached);
 

@@ -20,7 +20,8 @@ constexpr uint32_t kEndMark = 0x444e4549;
 
 // The shaders the passes compile (ibl_precompute.cpp); their includes are hashed with them.
 const char* const kPassShaders[] = {"equirect_to_cube.comp", "downsample_cube.comp", "prefilter_ggx.comp",
-                                    "sh9_project.comp",      "dfg_lut.comp",         "irradiance_cube.comp"};
+                                    "sh9_project.comp",      "dfg_lut.comp",         "irradiance_cube.comp",
+                                    "encode_storage.comp"};
 
 size_t texel_bytes(VkFormat f) {
     switch (f) {

@@ -42,6 +42,12 @@ struct PrefilterPush {
 };
 static_assert(sizeof(PrefilterPush) == 28, "prefilter_ggx.comp's Push block is 28 bytes");
 
+// encode_storage.comp's Push.
+struct EncodeStoragePush {
+    uint32_t width, height; // the level's size (a cube face's, or a 2D layout level's)
+};
+static_assert(sizeof(EncodeStoragePush) == 8, "encode_storage.comp's Push block is 8 bytes");
+
 // sh9_project.comp's Push.
 struct Sh9Push {
     uint32_t size;

@@ -11,6 +11,8 @@
 // The destination is a cube level or, for a 2D env_layout, one level of the octahedral or lat-long
 // map with its border (env_layout.glsl): a border texel is computed as the inner texel it copies
 // (same direction, same random rotation), so it holds exactly that texel's value.
+// The chain is written once in rgba32f (ibl_precompute.cpp: the radiance chain) and stored in the
+// format asked for by encode_storage.comp (pass 2b), so storage variants share one prefilter.
 #include "common.glsl"
 #include "env_layout.glsl"
 #include "brdf.glsl"
