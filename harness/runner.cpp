@@ -59,7 +59,8 @@ PoolOutcome run_tests(const std::vector<TestCase>& tests, const RunOptions& o, c
                 bool se = false;
                 TestCase tc = tests[i];
                 if (o.stability) tc.stability.enabled = true;
-                results[i] = run_test(tc, *w, store, out_dir, flip_threads, timing_repeats, se);
+                const int repeats = tc.timing_repeats ? tc.timing_repeats : timing_repeats; // the test's own wins
+                results[i] = run_test(tc, *w, store, out_dir, flip_threads, repeats, se);
                 if (se) shader_error = true;
                 int n = ++done;
                 if (!o.quiet) {

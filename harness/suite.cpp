@@ -316,7 +316,7 @@ TestEntry parse_test(const Ctx& c, const json& t, const std::string& w, const Su
     c.keys(t, w,
            {"scene", "method", "env", "size", "options", "variants", "baseline", "reference", "baseline_tolerances",
             "reference_band", "tags", "temporal", "stability", "max_cost_growth", "tolerance_note", "measure_only", "display",
-            "shader"});
+            "shader", "timing_repeats"});
     if (t.contains("tolerance_note")) c.str(t["tolerance_note"], w + ".tolerance_note");
     if (!t.contains("scene")) c.fail(w + ".scene", "missing required key");
     if (!t.contains("method")) c.fail(w + ".method", "missing required key");
@@ -354,6 +354,7 @@ TestEntry parse_test(const Ctx& c, const json& t, const std::string& w, const Su
     if (t.contains("baseline")) proto.baseline = c.boolean(t["baseline"], w + ".baseline");
     if (t.contains("reference")) proto.reference = c.boolean(t["reference"], w + ".reference");
     if (t.contains("measure_only")) proto.measure_only = c.boolean(t["measure_only"], w + ".measure_only");
+    if (t.contains("timing_repeats")) proto.timing_repeats = c.integer(t["timing_repeats"], w + ".timing_repeats", 1, 20);
     proto.baseline_tolerances = d.bounds;
     if (t.contains("baseline_tolerances"))
         for (auto& [k, v] : c.bounds(t["baseline_tolerances"], w + ".baseline_tolerances")) {

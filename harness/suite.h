@@ -55,7 +55,8 @@
 // own wins). Its tests are named with shader=<file stem> first in the variant, so they have their
 // own baselines; the file must exist when the suite is loaded.
 // timing_repeats renders each test that many times in all (1..20): the results then hold the
-// per-frame time's median and range (wall times vary 2-5x on a loaded machine; never gated).
+// per-frame time's median and range (wall times vary 2-5x on a loaded machine; never gated). A test's
+// own "timing_repeats" wins over the suite's (the nightly times its CPU reference once).
 #pragma once
 #include <filesystem>
 #include <map>
@@ -116,6 +117,7 @@ struct TestCase {
     std::vector<std::string> tags;
     TemporalSpec temporal;
     StabilitySpec stability;
+    int timing_repeats = 0; // the test's own "timing_repeats" (0: the suite's)
 };
 
 struct Suite {

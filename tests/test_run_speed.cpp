@@ -637,6 +637,45 @@ TEST(RunFacts, StartedIsTakenBeforeTheTests) {
     EXPECT_LE(started, before + 1) << "started " << run.results["started"] << ", the run took " << took << " s";
 }
 
+// A test's own "timing_repeats" wins over the suite's: the nightly renders its CPU reference once (its
+// three 64-spp renders were 68 s of a warm nightly's 158 s, and nobody gates on that time), every
+// other test three times. A test's value outside 1..20 is an error naming it.
+TEST(RunFacts, ATestsOwnTimingRepeatsWinsOverTheSuites) {
+    const fs::path dir = temp_dir("own_repeats");
+    write_file(dir / "r.json", R"({
+  "suite": "r",
+  "defaults": {"env": "constant:1", "timing_repeats": 3, "size": "64x32"},
+  "tests": [{"scene": "furnace", "method": "mobile", "baseline": false, "reference": false, "measure_only": true},
+            {"scene": "furnace", "method": "mobile", "options": {"storage": "rgbm8"}, "timing_repeats": 1,
+             "baseline": false, "reference": false, "measure_only": true}]
+})");
+    const Suite suite = load_suite((dir / "r.json").string());
+    ASSERT_EQ(suite.tests.size(), 2u);
+    EXPECT_EQ(suite.tests[0].timing_repeats, 0); // the suite's
+    EXPECT_EQ(suite.tests[1].timing_repeats, 1);
+    RunOptions o;
+    o.suite = (dir / "r.json").string();
+    o.goldens = dir / "goldens";
+    fs::create_directories(o.goldens / "baseline"); // measure_only tests read no golden
+    o.quiet = true;
+    const RunSummary run = run_suite(o);
+    ASSERT_EQ(run.exit_code(), kExitPass);
+    EXPECT_EQ(run.results["tests"][0]["frame_ms_samples"].size(), 3u);
+    EXPECT_FALSE(run.results["tests"][1].contains("frame_ms_samples")) << run.results["tests"][1].dump();
+    const Suite nightly = load_suite("nightly");
+    for (const TestCase& t : nightly.tests)
+        EXPECT_EQ(t.timing_repeats, t.spec.method == "reference" ? 1 : 0) << t.name;
+    write_file(dir / "bad.json", R"({"suite": "bad", "tests": [{"scene": "sphere", "method": "mobile", "timing_repeats": 0}]})");
+    std::string err;
+    try {
+        load_suite((dir / "bad.json").string());
+    } catch (const InputError& e) {
+        err = e.what();
+    }
+    EXPECT_NE(err.find("tests[0].timing_repeats: must be an integer in 1..20"), std::string::npos) << err;
+    fs::remove_all(dir);
+}
+
 // `--version` reads the commit from iblcheck_commit.txt beside the binary (written at every build),
 // so a bisect step whose commit (or a shader edit's dirty state) changed relinks nothing; compiled
 // in, it recompiled version.cpp and relinked the tool at every step. Without the file: "unknown".
