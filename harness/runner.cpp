@@ -38,24 +38,27 @@ struct PoolOutcome {
     bool shader_error = false;
 };
 
-// The tests on `jobs` worker threads (at most one a batch), each with its own renderer, taking the next
-// batch of tests as it finishes one; a line per test as it finishes unless quiet. Results stay in suite order.
+// The tests on `jobs` worker threads (at most one a batch), each with its own renderer, taking batches
+// of tests from the queue (batch_queue.h) as it finishes one; a line per test as it finishes unless
+// quiet. Results stay in suite order.
 PoolOutcome run_tests(const std::vector<TestCase>& tests, const RunOptions& o, const fs::path& out_dir, const GoldenStore& store,
                       int jobs, int timing_repeats) {
     const int flip_threads = jobs > 1 ? 1 : 0;
     std::vector<TestResult> results(tests.size());
-    const std::vector<std::vector<size_t>> batches = precompute_batches(tests);
+    const std::vector<ChainBatches> chains = precompute_batches(tests);
+    size_t batches = 0;
+    for (const ChainBatches& c : chains) batches += c.size();
+    BatchQueue queue(chains);
     std::atomic<int> done{0};
     std::atomic<bool> shader_error{false};
     std::mutex print_mutex;
     const bool interactive = isatty(STDOUT_FILENO);
     ConsoleBudget budget;
     // A worker's state is its GPU session (made on its own thread); a worker that cannot make one (no
-    // device) stops the run, and its error is rethrown here.
-    const auto workers = parallel_for(
-        int(batches.size()), jobs, [&] { return std::make_unique<Worker>(o.device); },
-        [&](int b, std::unique_ptr<Worker>& w) {
-            for (size_t i : batches[size_t(b)]) {
+    // device) stops the run, and its error is rethrown here. Worker `worker` keeps to its chain.
+    const auto run_batches = [&](int worker, std::unique_ptr<Worker>& w) {
+        while (const std::optional<Batch> batch = queue.next(worker))
+            for (size_t i : *batch) {
                 bool se = false;
                 TestCase tc = tests[i];
                 if (o.stability) tc.stability.enabled = true;
@@ -67,6 +70,24 @@ PoolOutcome run_tests(const std::vector<TestCase>& tests, const RunOptions& o, c
                     std::lock_guard lock(print_mutex);
                     print_test_line(to_json(results[i]), n, tests.size(), interactive, budget);
                 }
+            }
+    };
+    const auto workers = parallel_for(
+        int(std::min<size_t>(size_t(std::max(jobs, 1)), batches)), jobs,
+        [&] {
+            try {
+                return std::make_unique<Worker>(o.device);
+            } catch (...) {
+                queue.close(); // the other workers stop after their batch
+                throw;
+            }
+        },
+        [&](int worker, std::unique_ptr<Worker>& w) {
+            try {
+                run_batches(worker, w);
+            } catch (...) {
+                queue.close();
+                throw;
             }
         });
     json driver;
@@ -141,32 +162,32 @@ void check_output_options(const RunOptions& o, const Suite& suite) {
 
 } // namespace
 
-std::vector<std::vector<size_t>> precompute_batches(const std::vector<TestCase>& tests) {
-    std::vector<std::vector<size_t>> batches;
-    std::map<std::string, size_t> batch_of;
-    std::vector<std::string> full(tests.size());
+std::vector<ChainBatches> precompute_batches(const std::vector<TestCase>& tests) {
+    std::vector<ChainBatches> chains;
+    std::map<std::string, size_t> chain_of;
+    std::map<std::pair<size_t, std::string>, size_t> batch_of; // (chain, precompute) → batch in that chain
     for (size_t i = 0; i < tests.size(); ++i) {
-        std::string key;
+        std::string chain, full;
         try {
-            key = radiance_chain_share_key(tests[i].spec);
-            full[i] = precompute_share_key(tests[i].spec);
+            chain = radiance_chain_share_key(tests[i].spec);
+            full = precompute_share_key(tests[i].spec);
         } catch (const std::exception&) {
-            key = "unshared;" + std::to_string(i);
+            chain.clear();
         }
-        if (key.empty()) key = "unshared;" + std::to_string(i); // the CPU truth: nothing to share
-        auto [it, fresh] = batch_of.emplace(key, batches.size());
-        if (fresh) batches.emplace_back();
-        batches[it->second].push_back(i);
+        if (chain.empty()) chain = full = "unshared;" + std::to_string(i); // a bad option, or the CPU truth
+        auto [c, new_chain] = chain_of.emplace(chain, chains.size());
+        if (new_chain) chains.emplace_back();
+        auto [b, new_batch] = batch_of.emplace(std::make_pair(c->second, full), chains[c->second].size());
+        if (new_batch) chains[c->second].emplace_back();
+        chains[c->second][b->second].push_back(i);
     }
-    // Within a chain's batch, the tests of one precompute back to back (in suite order otherwise), so
-    // the session's few cached entries hold each while its tests run.
-    for (auto& b : batches) {
-        std::map<std::string, size_t> first;
-        for (size_t i : b) first.emplace(full[i], first.size());
-        std::stable_sort(b.begin(), b.end(), [&](size_t x, size_t y) { return first.at(full[x]) < first.at(full[y]); });
-    }
-    std::stable_sort(batches.begin(), batches.end(), [](const auto& a, const auto& b) { return a.size() > b.size(); });
-    return batches;
+    auto tests_in = [](const ChainBatches& c) {
+        size_t n = 0;
+        for (const Batch& b : c) n += b.size();
+        return n;
+    };
+    std::stable_sort(chains.begin(), chains.end(), [&](const auto& a, const auto& b) { return tests_in(a) > tests_in(b); });
+    return chains;
 }
 
 int RunSummary::exit_code() const { return run_exit_code(*this); }

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "batch_queue.h"
 #include "bless.h"
 #include "golden_store.h"
 #include "results/junit.h"
@@ -53,12 +54,13 @@ RunSummary run_suite(const RunOptions& options);
 // `o` with --history set to the suite's history file beside --out (Suite::history) when the run
 // names no --history and has an --out; otherwise `o` unchanged.
 RunOptions with_suite_history(RunOptions o, const Suite& suite);
-// `tests` (indices) in batches that share a radiance chain (renderer.h: radiance_chain_share_key),
-// largest first, each batch's tests of one precompute (precompute_share_key) back to back: a worker
-// takes a whole batch, so its session computes that chain once and each precompute once.
-// Handed out a test at a time, the two workers each computed most of them (the 71 ci tests: ~47
-// precomputes where 30 differ). A test whose options are bad gets a batch of its own (it fails
-// when it runs), and so does each CPU-truth test (nothing to share).
-std::vector<std::vector<size_t>> precompute_batches(const std::vector<TestCase>& tests);
+// `tests` (indices) in batches that share a precompute (renderer.h: precompute_share_key), in suite
+// order, grouped by the radiance chain they derive from (radiance_chain_share_key), chains with the
+// most tests first; the runner's workers take them from a BatchQueue (batch_queue.h), each keeping to
+// its chain, so a session computes each chain once and each precompute once. Handed out a test at a
+// time, the two workers each computed most of them (the 71 ci tests: ~47 precomputes where 30 differ).
+// A test whose options are bad gets a chain of its own (it fails when it runs), and so does each
+// CPU-truth test (nothing to share).
+std::vector<ChainBatches> precompute_batches(const std::vector<TestCase>& tests);
 
 } // namespace iblcheck

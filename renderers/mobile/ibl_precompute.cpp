@@ -219,8 +219,8 @@ void record_copy_image(const Recording& rec, const vk::Image& src, const vk::Ima
 }
 
 // The rgba32f chain in the storage format, level by level (encode_storage.comp).
-void record_encode_storage(const Recording& rec, const vk::ComputePipeline& p, const vk::Image& chain,
-                           const LayoutExtent& extent, uint32_t mips) {
+void record_encode_storage(const Recording& rec, const vk::ComputePipeline& p, const vk::Image& chain, const LayoutExtent& extent,
+                           uint32_t mips) {
     for (uint32_t m = 0; m < mips; ++m) {
         const EncodeStoragePush pe{std::max(1u, extent.width >> m), std::max(1u, extent.height >> m)};
         const std::vector<vk::Binding> b = {vk::Binding::storage_image(0, chain.storage_views[m]),
@@ -349,9 +349,10 @@ void record_irradiance(const Recording& rec) {
 // The radiance chain: the source cube's box pyramid, its SH9 and the GGX-prefiltered chain in
 // rgba32f (prefilter_ggx.comp with storage=rgba32f), computed once per environment and chain geometry
 // (size, levels, samples, mip_mapping, env_layout, rotation) and shared by every variant that only
-// stores it differently, or adds the DFG table or the irradiance cube. In the ci suite 33 of the 51
-// precomputes were such variants, each paying its own prefilter (~1.6 s each under lavapipe with
-// GALLIUM_OVERRIDE_CPU_CAPS=sse4.1: the portability run's largest stage; issue 33).
+// stores it differently, or adds the DFG table or the irradiance cube. The ci suite's 35 precomputes
+// come from 15 chains; each used to pay its own prefilter (~1.6 s under GALLIUM_OVERRIDE_CPU_CAPS=sse4.1,
+// the portability runs' largest stage). With the stores empty the ci suite's precompute took 39.2 s of
+// worker time, and 13.1 s with the chains shared (issue 33).
 PrecomputeSettings chain_settings(const PrecomputeSettings& s) {
     const PrecomputeSettings defaults;
     PrecomputeSettings c = s;
@@ -403,10 +404,10 @@ struct ChainEntry {
     std::vector<PassTiming> timings;
 };
 
-// The radiance chain through the session's cache (the runner gives one worker the tests that share a
-// chain: renderer.h precompute_share_key).
-std::shared_ptr<ChainEntry> radiance_chain(GpuSession& gpu, const Environment& env, const PrecomputeSettings& s,
-                                           EnvLayout layout, uint32_t mips) {
+// The radiance chain through the session's cache (the runner's workers each keep to a chain:
+// harness/batch_queue.h).
+std::shared_ptr<ChainEntry> radiance_chain(GpuSession& gpu, const Environment& env, const PrecomputeSettings& s, EnvLayout layout,
+                                           uint32_t mips) {
     const PrecomputeSettings c = chain_settings(s);
     const std::string key = "chain;" + precompute_key(env.content_hash, c);
     if (auto e = gpu.cached<ChainEntry>(key)) return e;
