@@ -369,6 +369,21 @@ PrecomputeSettings chain_settings(const PrecomputeSettings& s) {
 
 namespace {
 
+// One submission of passes into `r`, each timed; their GPU timings are appended as precompute passes.
+template <class Record>
+void submit_timed(GpuSession& gpu, const PrecomputeSettings& s, IblResources& r, std::vector<PassTiming>& timings,
+                  Record&& record) {
+    vk::Context& ctx = gpu.ctx();
+    vk::GpuTimer timer(ctx, 8);
+    ctx.submit([&](VkCommandBuffer cmd) {
+        const Recording rec{gpu, ctx, cmd, timer, s, r};
+        timer.reset(cmd);
+        record(rec);
+        ctx.barrier(cmd);
+    });
+    for (auto& [name, ms] : timer.results()) timings.push_back({name, ms, true, true});
+}
+
 IblResources compute_radiance_chain(GpuSession& gpu, const Environment& env, const PrecomputeSettings& c, EnvLayout layout,
                                     uint32_t mips, std::vector<PassTiming>& timings) {
     vk::Context& ctx = gpu.ctx();
@@ -383,19 +398,14 @@ IblResources compute_radiance_chain(GpuSession& gpu, const Environment& env, con
     const auto& p_sh = gpu.pipeline("sh9_project.comp", {}, {kStorageImage, kStorageBuffer}, sizeof(Sh9Push));
     const auto& p_pre =
         gpu.pipeline("prefilter_ggx.comp", storage_defines(c, r), {kSampled, kStorageImage}, sizeof(PrefilterPush));
-    vk::GpuTimer timer(ctx, 8);
-    ctx.submit([&](VkCommandBuffer cmd) {
-        const Recording rec{gpu, ctx, cmd, timer, c, r};
-        timer.reset(cmd);
+    submit_timed(gpu, c, r, timings, [&](const Recording& rec) {
         record_upload(rec, equirect);
         record_outputs_general(rec);
         record_equirect_to_cube(rec, p_e2c, equirect.image);
         record_downsample(rec, p_down);
         if (c.prefiltered) record_prefilter(rec, p_pre, extent, mips);
         record_sh9(rec, p_sh);
-        ctx.barrier(cmd);
     });
-    for (auto& [name, ms] : timer.results()) timings.push_back({name, ms, true, true});
     return r;
 }
 
@@ -442,18 +452,13 @@ IblResources run_precompute(GpuSession& gpu, const Environment& env, const Preco
     if (s.prefiltered && is_rgbm(s.storage)) fit_rgbm_range(ctx, chain->chain.source_cube, s.rgbm_range, r);
     const auto& p_enc =
         gpu.pipeline("encode_storage.comp", storage_defines(s, r), {kStorageImage, kStorageImage}, sizeof(EncodeStoragePush));
-    vk::GpuTimer timer(ctx, 8);
-    ctx.submit([&](VkCommandBuffer cmd) {
-        const Recording rec{gpu, ctx, cmd, timer, s, r};
-        timer.reset(cmd);
+    submit_timed(gpu, s, r, timings, [&](const Recording& rec) {
         record_outputs_general(rec);
         record_copy_image(rec, chain->chain.source_cube, r.source_cube);
         if (s.prefiltered) record_encode_storage(rec, p_enc, chain->chain.prefiltered, extent, mips);
         if (s.lut) record_dfg_lut(rec);
         if (s.irradiance_cube) record_irradiance(rec);
-        ctx.barrier(cmd);
     });
-    for (auto& [name, ms] : timer.results()) timings.push_back({name, ms, true, true});
     // ASTC is encoded on the host, so its round trip follows the GPU passes.
     if (s.prefiltered && is_astc(s.storage)) r.prefiltered = astc_round_trip(ctx, r.prefiltered, s, r.rgbm_range, timings);
     return r;
