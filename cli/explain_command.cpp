@@ -2,13 +2,13 @@
 #include <fmt/core.h>
 
 #include <chrono>
-#include <fstream>
 #include <sstream>
 
 #include "commands.h"
 #include "harness/error_budget.h"
 #include "harness/golden_store.h"
 #include "image_io/image_io.h"
+#include "kernel/atomic_file.h"
 #include "kernel/errors.h"
 #include "kernel/output_files.h"
 #include "renderers/renderer.h"
@@ -85,9 +85,7 @@ void run_explain(const ExplainArgs& a, int& exit_code) {
     fmt::print("{} under {}{}\n{}", a.scene, a.env, config.values().empty() ? "" : " with " + config.canonical(),
                budget_table(j));
     if (!a.json_out.empty()) {
-        std::ofstream f(a.json_out);
-        f << j.dump(2) << "\n";
-        if (!f) throw InputError(a.json_out + ": cannot write");
+        write_file_atomically(a.json_out, j.dump(2) + "\n", "error budget JSON");
     }
     exit_code = kExitPass;
 }

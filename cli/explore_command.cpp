@@ -3,13 +3,13 @@
 #include <fmt/core.h>
 
 #include <chrono>
-#include <fstream>
 
 #include "commands.h"
 #include "harness/error_budget.h"
 #include "harness/explore.h"
 #include "harness/golden_store.h"
 #include "image_io/image_io.h"
+#include "kernel/atomic_file.h"
 #include "kernel/errors.h"
 #include "kernel/output_files.h"
 #include "renderers/renderer.h"
@@ -99,9 +99,7 @@ nlohmann::json winners_suite(const ExploreArgs& a, const nlohmann::json& envs) {
 }
 
 void write_json(const std::string& path, const nlohmann::json& j) {
-    std::ofstream f(path);
-    f << j.dump(2) << "\n";
-    if (!f) throw InputError(path + ": cannot write");
+    write_file_atomically(path, j.dump(2) + "\n", "explore JSON");
 }
 
 void run_explore(const ExploreArgs& a, int& exit_code) {

@@ -2,10 +2,10 @@
 #include <fmt/core.h>
 
 #include <filesystem>
-#include <fstream>
 
 #include "commands.h"
 #include "image_io/image_io.h"
+#include "kernel/atomic_file.h"
 #include "kernel/errors.h"
 #include "kernel/output_files.h"
 #include "metrics/display_transform.h"
@@ -56,10 +56,7 @@ void write_render_json(const std::string& path, const nlohmann::json& j) {
     if (path == "-") {
         fmt::print("{}\n", j.dump(2));
     } else {
-        std::ofstream f(path);
-        f << j.dump(2) << "\n";
-        f.close();
-        if (!f) throw InputError(path + ": cannot write");
+        write_file_atomically(path, j.dump(2) + "\n", "render JSON");
     }
 }
 } // namespace

@@ -1,10 +1,10 @@
 #include "cli/report_command.h"
 
 #include <filesystem>
-#include <fstream>
 
 #include <fmt/core.h>
 
+#include "kernel/atomic_file.h"
 #include "kernel/errors.h"
 #include "kernel/output_files.h"
 #include "reports/merge_shards.h"
@@ -46,10 +46,7 @@ nlohmann::json merge_into(const std::vector<std::string>& files, const std::file
         fs::copy(images, out / "images", fs::copy_options::recursive | fs::copy_options::skip_existing, ec);
         if (ec) throw InputError(images.string() + ": cannot copy into " + (out / "images").string() + ": " + ec.message());
     }
-    std::ofstream f(out / "results.json");
-    f << merged.dump(1) << "\n";
-    f.close();
-    if (!f) throw InputError((out / "results.json").string() + ": cannot write");
+    write_file_atomically(out / "results.json", merged.dump(1) + "\n", "merged results JSON");
     return merged;
 }
 } // namespace

@@ -37,6 +37,18 @@ fs::path temporary_path(const fs::path& file) {
 }
 
 void write_file_atomically(const fs::path& file, std::string_view bytes, const std::string& what) {
+    // A device or a pipe named as the output (/dev/stdout, /dev/full, a FIFO) is written into: a rename
+    // would replace the node itself (run as root, `--junit /dev/full` turned /dev/full into a regular
+    // file when the JUnit writer became atomic; HostileOutput.AFullDiskAsOutIsExitTwoNamingThePath).
+    std::error_code ec;
+    if (const fs::file_status st = fs::status(file, ec); !ec && fs::exists(st) && !fs::is_regular_file(st)) {
+        errno = 0;
+        std::ofstream f(file, std::ios::binary);
+        f.write(bytes.data(), std::streamsize(bytes.size()));
+        f.close();
+        if (!f) throw InputError(cannot_write(file, what, errno ? std::strerror(errno) : "write failed"));
+        return;
+    }
     const fs::path tmp = temporary_path(file);
     errno = 0; // the reason a failed write gives is the one it sets
     {
@@ -54,6 +66,11 @@ void write_file_atomically(const fs::path& file, std::string_view bytes, const s
 }
 
 void write_file_atomically(const fs::path& file, const std::function<void(const fs::path&)>& write, const std::string& what) {
+    std::error_code ec;
+    if (const fs::file_status st = fs::status(file, ec); !ec && fs::exists(st) && !fs::is_regular_file(st)) {
+        write(file); // a device or a FIFO: written into, as above
+        return;
+    }
     const fs::path tmp = temporary_path(file);
     try {
         write(tmp);

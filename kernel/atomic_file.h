@@ -1,7 +1,8 @@
 // Files written whole or not at all. The content goes to a temporary file beside the target, named
 // for this process and thread (two writers never share one), which is then renamed over the target:
 // a reader sees the old file or the new one, never half of one. On any failure the temporary file
-// is removed. The folder must exist (the callers decide whether to create it).
+// is removed. The folder must exist (the callers decide whether to create it). A target that exists
+// and is not a regular file (a device, a FIFO) is written into, never replaced.
 #pragma once
 #include <filesystem>
 #include <functional>

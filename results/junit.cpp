@@ -2,8 +2,7 @@
 
 #include <fmt/core.h>
 
-#include <fstream>
-
+#include "kernel/atomic_file.h"
 #include "kernel/errors.h"
 #include "kernel/markup.h"
 
@@ -44,10 +43,7 @@ void write_junit(const json& results, const fs::path& file) {
     }
     x += "  </testsuite>\n</testsuites>\n";
     if (!file.parent_path().empty()) fs::create_directories(file.parent_path());
-    std::ofstream f(file);
-    f << x;
-    f.close(); // a full disk shows at the last write, on close
-    if (!f) throw InputError(file.string() + ": cannot write JUnit XML");
+    write_file_atomically(file, x, "JUnit XML"); // a CI reading it mid-write sees the old file or the new, never half
 }
 
 } // namespace iblcheck

@@ -2,8 +2,10 @@
 // JSON, the golden store. A failed write names the file and leaves no temporary file behind (the results
 // JSON's and the report page's copies left theirs when the rename failed); the golden store, the one
 // writer of goldens, keeps an EXR whose pixels are bit-identical (the truth's rule, now bless's too).
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <set>
@@ -51,6 +53,24 @@ TEST_F(AtomicFile, WritesTheBytesAsTheyAreAndReplacesAWholeFile) {
     write_file_atomically(dir_ / "f.bin", "short");
     EXPECT_EQ(testutil::read_text(dir_ / "f.bin"), "short");
     EXPECT_EQ(names(), std::set<std::string>{"f.bin"});
+}
+
+// A target that is a FIFO (or a device: /dev/stdout, /dev/full) is written into and stays what it is:
+// renamed over, the node itself was replaced by a regular file (as root, `--junit /dev/full` turned
+// /dev/full into one). A reader on the FIFO gets the bytes; nothing is left beside it.
+TEST_F(AtomicFile, AFifoTargetIsWrittenIntoNotReplaced) {
+    const fs::path fifo = dir_ / "out.xml";
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+    // Opened read-write, a FIFO never blocks: this end is its reader, and a write of a few bytes fits.
+    const int fd = ::open(fifo.c_str(), O_RDWR | O_NONBLOCK);
+    ASSERT_GE(fd, 0);
+    write_file_atomically(fifo, "<testsuites/>\n", "JUnit XML");
+    char buf[64];
+    const ssize_t n = ::read(fd, buf, sizeof buf);
+    ::close(fd);
+    EXPECT_EQ(std::string(buf, size_t(std::max<ssize_t>(n, 0))), "<testsuites/>\n");
+    EXPECT_TRUE(fs::is_fifo(fifo));
+    EXPECT_EQ(names(), std::set<std::string>{"out.xml"});
 }
 
 // The target is a folder that is not empty: the rename fails. The error names the file and what it is;

@@ -15,6 +15,7 @@
 #include "harness/suite.h"
 #include "kernel/errors.h"
 #include "reports/report_writer.h"
+#include "results/junit.h"
 #include "tests/furnace_store.h"
 #include "tests/test_support.h"
 
@@ -95,6 +96,41 @@ TEST(HostileOutput, RenderTruthRunAndReportRefuseToOverwrite) {
               2)
         << out;
     EXPECT_NE(out.find("holds files"), std::string::npos) << out;
+}
+
+// JUnit XML, `render --json` and `report`'s merged results are written beside their file and renamed
+// over it (kernel/atomic_file.h), never rewritten in place: a reader that opened the old file (here a
+// hard link to it) still holds it whole, and no temporary file is left. They used to be truncated and
+// rewritten where they stood (a CI reading the JUnit file mid-write saw half of it; a full disk left
+// half a file and lost the old one). explain --json and explore --json are written the same way.
+TEST(HostileOutput, OutputsReplaceTheOldFileWholeNeverInPlace) {
+    const fs::path dir = temp_dir("whole_outputs");
+    auto old_file_with_reader = [&](const fs::path& f) {
+        write_file(f, "old");
+        const fs::path reader = fs::path(f.string() + ".reader");
+        fs::create_hard_link(f, reader);
+        return reader;
+    };
+    const fs::path junit = dir / "junit.xml";
+    const fs::path junit_reader = old_file_with_reader(junit);
+    write_junit(nlohmann::json{{"suite", "s"}, {"total_s", 1.0}, {"tests", nlohmann::json::array()}}, junit);
+    EXPECT_EQ(bytes(junit_reader), "old");
+    EXPECT_NE(bytes(junit).find("<testsuites"), std::string::npos);
+
+    const fs::path render = dir / "render.json";
+    const fs::path render_reader = old_file_with_reader(render);
+    std::string out;
+    ASSERT_EQ(run_command(bin("iblcheck") + " render --scene sphere --env constant:1 --size 16x16 --json " + render.string() +
+                              " --force",
+                          out),
+              0)
+        << out;
+    EXPECT_EQ(bytes(render_reader), "old");
+    EXPECT_NE(bytes(render).find("\"timings\""), std::string::npos) << bytes(render);
+    size_t files = 0;
+    for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir)) ++files;
+    EXPECT_EQ(files, 4u) << "a temporary file was left in " << dir;
+    fs::remove_all(dir);
 }
 
 TEST(HostileOutput, ASecondRunIntoAnOutFolderIsRefusedThenReplacedWholeWithForce) {
