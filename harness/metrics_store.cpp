@@ -2,11 +2,10 @@
 
 #include <cstdint>
 #include <cstring>
-#include <fstream>
 
 #include "image_io/image_hash.h"
-#include "kernel/atomic_file.h"
 #include "kernel/hash.h"
+#include "kernel/store_entry.h"
 #include "renderers/vulkan/shader_compiler.h"
 
 namespace fs = std::filesystem;
@@ -90,11 +89,7 @@ void append_map(std::string& bytes, const FlipResult& r) {
 
 } // namespace
 
-fs::path metrics_store_dir() {
-    if (const char* dir = std::getenv("IBLCHECK_METRICS_CACHE"); dir && *dir)
-        return std::string(dir) == "0" ? fs::path() : fs::path(dir);
-    return vk::spirv_cache_dir().parent_path() / "metrics";
-}
+fs::path metrics_store_dir() { return store_dir("IBLCHECK_METRICS_CACHE", vk::spirv_cache_dir().parent_path() / "metrics"); }
 
 std::string metrics_store_key(const cv::Mat& golden, const cv::Mat& test, const DisplaySpace* display, const std::string& tool) {
     Fnv1a64 h;
@@ -107,17 +102,14 @@ std::string metrics_store_key(const cv::Mat& golden, const cv::Mat& test, const 
 
 std::optional<Measured> load_measured(const std::string& key) {
     if (metrics_store_dir().empty()) return std::nullopt;
-    std::ifstream f(entry_path(key), std::ios::binary);
-    if (!f) return std::nullopt;
-    const std::string bytes((std::istreambuf_iterator<char>(f)), {});
     // The magic, the key again (a renamed or misplaced file is a miss), the header's length, the
     // header (JSON), the maps.
-    const std::string head = std::string(kMagic) + key;
+    const std::optional<std::string> entry = read_store_entry(entry_path(key), std::string(kMagic) + key);
     uint64_t header_size = 0;
-    if (bytes.size() < head.size() + sizeof header_size || bytes.compare(0, head.size(), head) != 0) return std::nullopt;
-    std::memcpy(&header_size, bytes.data() + head.size(), sizeof header_size);
-    const char* data = bytes.data() + head.size() + sizeof header_size;
-    size_t size = bytes.size() - head.size() - sizeof header_size;
+    if (!entry || entry->size() < sizeof header_size) return std::nullopt;
+    std::memcpy(&header_size, entry->data(), sizeof header_size);
+    const char* data = entry->data() + sizeof header_size;
+    size_t size = entry->size() - sizeof header_size;
     if (header_size > size) return std::nullopt;
     try {
         const json header = json::parse(data, data + header_size);
@@ -149,9 +141,7 @@ void save_measured(const std::string& key, const Measured& m) {
     bytes += text;
     append_map(bytes, m.linear);
     if (m.shown) append_map(bytes, *m.shown);
-    std::error_code ec;
-    fs::create_directories(metrics_store_dir(), ec);
-    try_write_file_atomically(entry_path(key), bytes); // a failure is no error: the next run measures again
+    write_store_entry(entry_path(key), bytes); // a failure is no error: the next run measures again
 }
 
 } // namespace iblcheck

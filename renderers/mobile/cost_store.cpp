@@ -1,10 +1,10 @@
 #include "cost_store.h"
 
 #include <cstring>
-#include <fstream>
 
 #include "kernel/cpu_caps.h"
 #include "kernel/hash.h"
+#include "kernel/store_entry.h"
 #include "precompute_store.h"
 #include "renderers/vulkan/shader_compiler.h"
 
@@ -20,11 +20,7 @@ fs::path entry_path(const std::string& key) { return cost_store_dir() / (key + "
 
 } // namespace
 
-fs::path cost_store_dir() {
-    if (const char* dir = std::getenv("IBLCHECK_COST_CACHE"); dir && *dir)
-        return std::string(dir) == "0" ? fs::path() : fs::path(dir);
-    return vk::spirv_cache_dir().parent_path() / "cost";
-}
+fs::path cost_store_dir() { return store_dir("IBLCHECK_COST_CACHE", vk::spirv_cache_dir().parent_path() / "cost"); }
 
 std::string bytes_hash(const void* data, size_t n) {
     Fnv1a64 h;
@@ -50,14 +46,11 @@ std::string cost_store_key(GpuSession& gpu, const std::vector<std::string>& part
 
 std::optional<double> load_cost(const std::string& key) {
     if (cost_store_dir().empty()) return std::nullopt;
-    std::ifstream f(entry_path(key), std::ios::binary);
-    if (!f) return std::nullopt;
-    const std::string bytes((std::istreambuf_iterator<char>(f)), {});
     // The magic, the key again (a renamed or misplaced file is a miss), the double's bits.
-    const std::string head = std::string(kMagic) + key;
-    if (bytes.size() != head.size() + sizeof(double) || bytes.compare(0, head.size(), head) != 0) return std::nullopt;
+    const std::optional<std::string> bits = read_store_entry(entry_path(key), std::string(kMagic) + key);
+    if (!bits || bits->size() != sizeof(double)) return std::nullopt;
     double v = 0;
-    std::memcpy(&v, bytes.data() + head.size(), sizeof v);
+    std::memcpy(&v, bits->data(), sizeof v);
     if (!(v >= 0)) return std::nullopt; // a count is finite and not negative
     return v;
 }

@@ -1,12 +1,11 @@
 #include "precompute_store.h"
 
 #include <cstring>
-#include <fstream>
 
-#include "kernel/atomic_file.h"
 #include "kernel/cpu_caps.h"
 #include "kernel/hash.h"
 #include "kernel/profile.h"
+#include "kernel/store_entry.h"
 #include "renderers/vulkan/shader_compiler.h"
 
 namespace fs = std::filesystem;
@@ -19,9 +18,8 @@ constexpr uint32_t kMagic = 0x31434249; // "IBC1": this layout; another is a mis
 constexpr uint32_t kEndMark = 0x444e4549;
 
 // The shaders the passes compile (ibl_precompute.cpp); their includes are hashed with them.
-const char* const kPassShaders[] = {"equirect_to_cube.comp", "downsample_cube.comp", "prefilter_ggx.comp",
-                                    "sh9_project.comp",      "dfg_lut.comp",         "irradiance_cube.comp",
-                                    "encode_storage.comp"};
+const char* const kPassShaders[] = {"equirect_to_cube.comp", "downsample_cube.comp", "prefilter_ggx.comp", "sh9_project.comp",
+                                    "dfg_lut.comp",          "irradiance_cube.comp", "encode_storage.comp"};
 
 size_t texel_bytes(VkFormat f) {
     switch (f) {
@@ -116,9 +114,7 @@ fs::path entry_path(const std::string& key) { return precompute_store_dir() / (k
 } // namespace
 
 fs::path precompute_store_dir() {
-    if (const char* dir = std::getenv("IBLCHECK_PRECOMPUTE_CACHE"); dir && *dir)
-        return std::string(dir) == "0" ? fs::path() : fs::path(dir);
-    return vk::spirv_cache_dir().parent_path() / "precompute";
+    return store_dir("IBLCHECK_PRECOMPUTE_CACHE", vk::spirv_cache_dir().parent_path() / "precompute");
 }
 
 std::string precompute_store_key(GpuSession& gpu, const Environment& env, const PrecomputeSettings& s, const std::string& tool) {
@@ -136,9 +132,9 @@ std::string precompute_store_key(GpuSession& gpu, const Environment& env, const 
 std::optional<IblResources> load_precompute(vk::Context& ctx, const std::string& key, std::vector<PassTiming>& timings) {
     if (precompute_store_dir().empty()) return std::nullopt;
     ProfileStage stage("precompute_store");
-    std::ifstream f(entry_path(key), std::ios::binary);
-    if (!f) return std::nullopt;
-    const std::string bytes((std::istreambuf_iterator<char>(f)), {});
+    const std::optional<std::string> entry = read_store_entry(entry_path(key), {}); // the magic is read below
+    if (!entry) return std::nullopt;
+    const std::string& bytes = *entry;
     Reader rd{bytes};
     uint32_t magic = 0, end = 0, n_timings = 0;
     uint8_t native = 0;
@@ -192,12 +188,6 @@ void save_precompute(vk::Context& ctx, const std::string& key, const IblResource
     put_image(ctx, w, r.irradiance);
     w.put(kEndMark);
     write_store_entry(entry_path(key), w.bytes);
-}
-
-void write_store_entry(const fs::path& file, std::string_view bytes) {
-    std::error_code ec;
-    fs::create_directories(file.parent_path(), ec);
-    try_write_file_atomically(file, bytes); // a failure is no error: the next run computes it again
 }
 
 } // namespace iblcheck

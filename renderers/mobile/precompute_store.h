@@ -32,11 +32,6 @@ std::string precompute_store_key(GpuSession& gpu, const Environment& env, const 
 // when there is no whole entry (a damaged one is ignored).
 std::optional<IblResources> load_precompute(vk::Context& ctx, const std::string& key, std::vector<PassTiming>& timings);
 
-// Writes a store entry: `bytes` into a temporary file of this process and thread, renamed onto `file`
-// (readers see a whole entry or none); a failure to write is ignored (the stores are an optimisation).
-// The precompute and count stores (cost_store.h) both write through it.
-void write_store_entry(const std::filesystem::path& file, std::string_view bytes);
-
 // Stores `r` under `key` (atomically: a temporary file renamed); a failure to write is ignored (the
 // cache is an optimisation).
 void save_precompute(vk::Context& ctx, const std::string& key, const IblResources& r, const std::vector<PassTiming>& timings);
