@@ -6,12 +6,6 @@ BatchQueue::BatchQueue(const std::vector<ChainBatches>& chains) : workers_on_(ch
     for (const ChainBatches& c : chains) chains_.emplace_back(c.begin(), c.end());
 }
 
-size_t BatchQueue::tests_left(size_t chain) const {
-    size_t n = 0;
-    for (const Batch& b : chains_[chain]) n += b.size();
-    return n;
-}
-
 std::optional<Batch> BatchQueue::next(int w) {
     std::lock_guard lock(mutex_);
     size_t chain = chains_.size();
@@ -28,7 +22,8 @@ std::optional<Batch> BatchQueue::next(int w) {
             if (!chains_[c].empty() && workers_on_[c] == 0) chain = c;
         if (chain == chains_.size()) // every chain left has a worker: join the one with the most tests left
             for (size_t c = 0; c < chains_.size(); ++c)
-                if (!chains_[c].empty() && (chain == chains_.size() || tests_left(c) > tests_left(chain))) chain = c;
+                if (!chains_[c].empty() && (chain == chains_.size() || tests_in(chains_[c]) > tests_in(chains_[chain])))
+                    chain = c;
         if (chain == chains_.size()) return std::nullopt;
         ++workers_on_[chain];
         chain_of_[w] = chain;

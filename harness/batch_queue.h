@@ -18,6 +18,13 @@ namespace iblcheck {
 using Batch = std::vector<size_t>;       // test indices that share one precompute
 using ChainBatches = std::vector<Batch>; // the batches of one radiance chain
 
+// How many tests batches hold (a chain's, or what is left of it).
+template <class Batches> size_t tests_in(const Batches& batches) {
+    size_t n = 0;
+    for (const Batch& b : batches) n += b.size();
+    return n;
+}
+
 class BatchQueue {
   public:
     explicit BatchQueue(const std::vector<ChainBatches>& chains);
@@ -27,7 +34,6 @@ class BatchQueue {
     void close();
 
   private:
-    size_t tests_left(size_t chain) const;
     std::mutex mutex_;
     std::vector<std::deque<Batch>> chains_;
     std::vector<int> workers_on_;    // per chain

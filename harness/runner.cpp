@@ -181,12 +181,7 @@ std::vector<ChainBatches> precompute_batches(const std::vector<TestCase>& tests)
         if (new_batch) chains[c->second].emplace_back();
         chains[c->second][b->second].push_back(i);
     }
-    auto tests_in = [](const ChainBatches& c) {
-        size_t n = 0;
-        for (const Batch& b : c) n += b.size();
-        return n;
-    };
-    std::stable_sort(chains.begin(), chains.end(), [&](const auto& a, const auto& b) { return tests_in(a) > tests_in(b); });
+    std::stable_sort(chains.begin(), chains.end(), [](const auto& a, const auto& b) { return tests_in(a) > tests_in(b); });
     return chains;
 }
 
