@@ -1,6 +1,7 @@
 #include "renderer.h"
 
 #include <chrono>
+#include <optional>
 #include <set>
 
 #include "kernel/errors.h"
@@ -68,16 +69,23 @@ void validate_spec(const TestSpec& spec) {
     build_scene(spec.scene, spec.options); // unknown scene or bad material option: UsageError
 }
 
+namespace {
+// The GPU precompute's settings of a render of `spec`; none for the CPU truth.
+std::optional<PrecomputeSettings> gpu_precompute_settings(const TestSpec& spec) {
+    if (spec.method == "mobile") return mobile_precompute_settings(spec);
+    if (spec.method == "sampled") return sampled_precompute_settings(spec);
+    return std::nullopt;
+}
+} // namespace
+
 std::string precompute_share_key(const TestSpec& spec) {
-    if (spec.method == "mobile") return precompute_key(spec.env, mobile_precompute_settings(spec));
-    if (spec.method == "sampled") return precompute_key(spec.env, sampled_precompute_settings(spec));
-    return "";
+    const std::optional<PrecomputeSettings> s = gpu_precompute_settings(spec);
+    return s ? precompute_key(spec.env, *s) : "";
 }
 
 std::string radiance_chain_share_key(const TestSpec& spec) {
-    if (spec.method == "mobile") return precompute_key(spec.env, chain_settings(mobile_precompute_settings(spec)));
-    if (spec.method == "sampled") return precompute_key(spec.env, chain_settings(sampled_precompute_settings(spec)));
-    return "";
+    const std::optional<PrecomputeSettings> s = gpu_precompute_settings(spec);
+    return s ? precompute_key(spec.env, chain_settings(*s)) : "";
 }
 
 Renderer::Renderer(vk::ContextOptions options) : options_(std::move(options)) {}
