@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "kernel/errors.h"
+#include "metrics/catalog.h"
 
 using nlohmann::json;
 
@@ -43,22 +44,31 @@ WorstBlock worst_block_from_json(const json& j) {
 
 json to_json(const Timing& t) { return {{"pass", t.pass}, {"ms", t.ms}, {"gpu", t.gpu}, {"precompute", t.precompute}}; }
 
+// A figure's name in the accuracy summary: the metric catalog's (metrics/catalog.h, accuracy_name).
+namespace {
+const char* summary_name(const char* metric_key) { return metric(metric_key).accuracy_name; }
+} // namespace
+
 json to_json(const Accuracy& a) {
     const auto& [flip_mean, ssim, golden, noise_floor, display] = a; // every member
     // SSIM of an image smaller than its window is NaN here, null in the JSON.
-    json j = {{"flip_mean", flip_mean}, {"ssim", finite_or_null(ssim)}, {"golden", golden}, {"noise_floor", noise_floor}};
+    json j = {{summary_name("flip.mean"), flip_mean},
+              {summary_name("ssim.mean"), finite_or_null(ssim)},
+              {"golden", golden},
+              {"noise_floor", noise_floor}};
     if (display)
         j["display"] = {{"space", display->space},
-                        {"flip_mean", finite_or_null(display->flip_mean)},
-                        {"ssim", finite_or_null(display->ssim)},
-                        {"psnr_db", finite_or_null(display->psnr_db)}};
+                        {summary_name("display_flip.mean"), finite_or_null(display->flip_mean)},
+                        {summary_name("display_ssim.mean"), finite_or_null(display->ssim)},
+                        {summary_name("display_psnr.db"), finite_or_null(display->psnr_db)}};
     return j;
 }
 Accuracy accuracy_from_json(const json& j) {
-    Accuracy a{number_or_nan(j, "flip_mean"), number_or_nan(j, "ssim"), string_of(j, "golden"), json_of(j, "noise_floor"), {}};
+    Accuracy a{number_or_nan(j, summary_name("flip.mean")), number_or_nan(j, summary_name("ssim.mean")), string_of(j, "golden"),
+               json_of(j, "noise_floor"), {}};
     if (const json d = json_of(j, "display"); d.is_object())
-        a.display = DisplayAccuracy{json_of(d, "space"), number_or_nan(d, "flip_mean"), number_or_nan(d, "ssim"),
-                                    number_or_nan(d, "psnr_db")};
+        a.display = DisplayAccuracy{json_of(d, "space"), number_or_nan(d, summary_name("display_flip.mean")),
+                                    number_or_nan(d, summary_name("display_ssim.mean")), number_or_nan(d, summary_name("display_psnr.db"))};
     return a;
 }
 

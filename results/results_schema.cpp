@@ -12,6 +12,7 @@
 #include "kernel/errors.h"
 #include "kernel/input_file.h"
 #include "kernel/json_check.h"
+#include "metrics/catalog.h"
 #include "results/results.h"
 #include "results/results_file.h"
 
@@ -120,10 +121,10 @@ void check_measurements(const Checker& c, const json& t, const std::string& wher
             c.boolean(p, pw, "precompute");
         }
     if (const json* acc = c.object(t, where, "accuracy")) {
-        c.number(*acc, where + ": accuracy", "flip_mean");
+        c.number(*acc, where + ": accuracy", metric("flip.mean").accuracy_name);
         c.string_(*acc, where + ": accuracy", "golden");
         if (const json* d = c.object(*acc, where + ": accuracy", "display")) // the truth as a player sees it
-            c.number(*d, where + ": accuracy.display", "flip_mean");
+            c.number(*d, where + ": accuracy.display", metric("display_flip.mean").accuracy_name);
     }
     if (const json* ps = c.array(t, where, "per_sphere"))
         for (size_t k = 0; k < ps->size(); ++k) {

@@ -3,11 +3,13 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <map>
 #include <regex>
 #include <set>
 #include <sstream>
 
 #include "kernel/errors.h"
+#include "metrics/catalog.h"
 #include "results/results.h"
 #include "results/results_file.h"
 
@@ -164,6 +166,40 @@ TEST(Results, FromJsonReadsBackWhatToJsonWrote) {
     nan.accuracy->ssim = std::nan("");
     EXPECT_TRUE(to_json(nan)["accuracy"]["ssim"].is_null());
     EXPECT_TRUE(std::isnan(to_json(nan).get<TestResult>().accuracy->ssim));
+}
+
+// The accuracy summary's figures are the metric catalog's, by the catalog's names (accuracy_name):
+// each judged metric that has one is written there with the value of its own field, and the summary
+// holds no other figure. A name added to the catalog but not written, or written under another
+// name, fails here.
+TEST(Results, TheAccuracySummaryHoldsTheCatalogsFiguresByTheirNames) {
+    const TestResult t = full_test();
+    const Accuracy& a = *t.accuracy;
+    const json j = to_json(t)["accuracy"];
+    const std::map<std::string, double> value = {{"flip.mean", a.flip_mean},
+                                                 {"ssim.mean", a.ssim},
+                                                 {"display_flip.mean", a.display->flip_mean},
+                                                 {"display_ssim.mean", a.display->ssim},
+                                                 {"display_psnr.db", a.display->psnr_db}};
+    std::set<std::string> linear, display;
+    for (const MetricInfo* k : judged_metrics(true)) {
+        if (!*k->accuracy_name) continue;
+        const bool shown = k->space == MetricSpace::test_display;
+        (shown ? display : linear).insert(k->accuracy_name);
+        const json& where = shown ? j["display"] : j;
+        ASSERT_TRUE(where.contains(k->accuracy_name)) << k->key << " as " << k->accuracy_name;
+        ASSERT_TRUE(value.count(k->key)) << k->key << ": a summary figure this test does not know";
+        EXPECT_EQ(where[k->accuracy_name].get<double>(), value.at(k->key)) << k->key;
+    }
+    std::set<std::string> written, written_display;
+    for (const auto& [key, v] : j.items())
+        if (v.is_number()) written.insert(key);
+    for (const auto& [key, v] : j["display"].items())
+        if (v.is_number()) written_display.insert(key);
+    EXPECT_EQ(written, linear);
+    EXPECT_EQ(written_display, display);
+    EXPECT_EQ(written.size(), 2u);
+    EXPECT_EQ(written_display.size(), 3u);
 }
 
 // The reader checks every key fields() marks checked by its type, and names it.
