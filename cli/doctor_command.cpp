@@ -12,6 +12,7 @@
 #include "harness/provenance.h"
 #include "kernel/cpu_caps.h"
 #include "kernel/errors.h"
+#include "kernel/program.h"
 #include "renderers/vulkan/context.h"
 #include "renderers/vulkan/fp16_emulation.h"
 
@@ -81,6 +82,8 @@ void register_doctor_command(CLI::App& app, int& exit_code) {
         fmt::print("timestamps:      {} (period {} ns)\n", i.timestamps ? "yes" : "no", i.timestamp_period_ns);
         fmt::print("validation:      {}\n", i.validation ? "on" : "off");
         fmt::print("shader folder:   {}\n", vk::shader_dir().string());
+        // The precompute and cost stores' code key (program.h): what a rebuild keeps or misses.
+        fmt::print("store code key:  {}\n", render_code_hash());
         // What llvmpipe generates shader code for (lavapipe compiles for the host CPU); meaningful
         // when the driver is llvmpipe.
         LlvmpipeCaps caps = llvmpipe_caps();

@@ -59,6 +59,18 @@ std::string file_content_hash(const std::string& path) {
     return f.bad() ? "" : h.hex();
 }
 
+// Defined by the iblcheck binary (its generated render_code_hash.cpp); this weak one stands in for it
+// in every other program.
+extern "C" __attribute__((weak)) const char* iblcheck_render_code_hash_generated() { return nullptr; }
+
+const std::string& render_code_hash() {
+    static const std::string hash = [] {
+        const char* built = iblcheck_render_code_hash_generated();
+        return built && *built ? "render-code:" + std::string(built) : running_binary_hash();
+    }();
+    return hash;
+}
+
 const std::string& running_binary_hash() {
     static const std::string hash = [] {
         std::string h = file_content_hash("/proc/self/exe");

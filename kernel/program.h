@@ -27,4 +27,12 @@ std::string file_content_hash(const std::string& path);
 // by content on their own). "unreadable" when /proc/self/exe cannot be read (every build then shares it).
 const std::string& running_binary_hash();
 
+// The part of the precompute and cost stores' keys that stands for the C++ computing what they hold:
+// a hash of the renderer libraries and libastcenc, taken when the iblcheck binary is built
+// (cmake/render_code_hash.cmake, cli/CMakeLists.txt). A change to the harness, the report or the CLI
+// keeps it, so a nightly or a bisect step after such a change reads the entries an earlier build
+// made; a change to a renderer library (or a new libastcenc) is a miss. A binary built without the
+// hash (the test programs) uses running_binary_hash(), as every store did before (issue 33).
+const std::string& render_code_hash();
+
 } // namespace iblcheck

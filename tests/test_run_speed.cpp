@@ -406,6 +406,10 @@ TEST(PrecomputeStore, ToolPartIsTheRunningBinarysContent) {
     Fnv1a64 h;
     h.update(bytes);
     EXPECT_EQ(running_binary_hash(), h.hex());
+    // The precompute and cost stores' code key: in the iblcheck binary, the renderer libraries' hash
+    // its build generated (stores.render_code_hash checks that); in a program built without it, like
+    // this one, the running binary's content.
+    EXPECT_EQ(render_code_hash(), running_binary_hash());
 
     const fs::path dir = temp_dir("tool_hash");
     std::string copy = bytes.substr(0, 4096);

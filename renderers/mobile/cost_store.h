@@ -5,7 +5,8 @@
 // defines, options, a team's ibl_shade file, the counting pass's version), the push constants
 // (size, ssaa, options), the draw's shape, the content of what the pass reads (the environment's
 // precompute, keyed as precompute_store.h keys it, and the scene), the device and driver, llvmpipe's
-// CPU class, the running binary's content (the counting pass's host side is C++), and the timed pass's output image: the stored count was checked against an image equal
+// CPU class, the renderer libraries' code (program.h: render_code_hash; the counting pass's host side
+// is C++), and the timed pass's output image: the stored count was checked against an image equal
 // to it bit for bit. A changed input is a miss; a damaged entry is counted again.
 // IBLCHECK_COST_CACHE=0 turns it off; =DIR puts it there (default: beside the SPIR-V cache, cost/).
 #pragma once
@@ -30,10 +31,10 @@ std::string shading_inputs_hash(GpuSession& gpu, const Environment& env, const P
                                 const vk::Buffer& scene_buf);
 
 // The entry's name: a hash of `parts` (the pass's inputs), the device, driver and CPU class.
-// `tool`: the build of iblcheck that counts (program.h: running_binary_hash): the counting pass's
-// host side is C++.
+// `tool`: the C++ that counts (program.h: render_code_hash, the renderer libraries of the build): the
+// counting pass's host side is C++.
 std::string cost_store_key(GpuSession& gpu, const std::vector<std::string>& parts,
-                           const std::string& tool = running_binary_hash());
+                           const std::string& tool = render_code_hash());
 
 // A content hash of `n` bytes (push constants, output images) for a key part.
 std::string bytes_hash(const void* data, size_t n);

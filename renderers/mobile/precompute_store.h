@@ -3,8 +3,8 @@
 // IblResources, byte for byte as the passes wrote them, so a render from it is bit-identical.
 // Its name is a hash of every input: the environment's pixels (content hash), every setting, the
 // sources of the passes' shaders and what they include, the device and driver (Mesa, LLVM) and
-// llvmpipe's CPU class (its generated code can round differently), and the running binary's content
-// (the tool's own C++: another build's entries are misses). A changed input is a miss, and
+// llvmpipe's CPU class (its generated code can round differently), and the renderer libraries' code
+// (program.h: render_code_hash; a build with other renderer code or another libastcenc misses). A changed input is a miss, and
 // a damaged entry is computed again. IBLCHECK_PRECOMPUTE_CACHE=0 turns it off; =DIR puts it there.
 #pragma once
 #include <filesystem>
@@ -23,10 +23,10 @@ namespace iblcheck {
 std::filesystem::path precompute_store_dir();
 
 // The entry's name: a hash over every input (see above).
-// `tool`: the build of iblcheck that computes it (program.h: running_binary_hash), so an entry another
-// build wrote (a bisect step across a C++ change) is a miss.
+// `tool`: the C++ that computes it (program.h: render_code_hash, the renderer libraries of the build),
+// so an entry a build with other renderer code wrote (a bisect step across such a change) is a miss.
 std::string precompute_store_key(GpuSession& gpu, const Environment& env, const PrecomputeSettings& s,
-                                 const std::string& tool = running_binary_hash());
+                                 const std::string& tool = render_code_hash());
 
 // The resources stored under `key` on this device, and the timings they were first made with; none
 // when there is no whole entry (a damaged one is ignored).
