@@ -19,20 +19,20 @@ std::string program_from_self();
 // The content hash (FNV-1a 64, hex) of the file at `path`; empty when it cannot be read.
 std::string file_content_hash(const std::string& path);
 
-// The running binary's content hash (/proc/self/exe), computed once: the part of the on-disk stores'
-// keys (precompute_store.h, cost_store.h) that stands for the tool's own C++ (ASTC encoding, SH
-// projection, the counting pass's host side). Without it an entry made by another build of the tool
-// was read back: a bisect across a C++ change, whose steps share .cache/, judged each commit with the
-// first one's precompute. A shader-only change relinks nothing and keeps the hash (shaders are keyed
-// by content on their own). "unreadable" when /proc/self/exe cannot be read (every build then shares it).
+// The running binary's content hash (/proc/self/exe), computed once: the metrics store's key part for
+// the tool's own C++ (harness/metrics_store.h), and the precompute and cost stores' where the binary
+// has no render_code_hash. Without it an entry made by another build of the tool was read back: a
+// bisect across a C++ change, whose steps share .cache/, judged each commit with the first one's
+// precompute. A shader-only change relinks nothing and keeps the hash (shaders are keyed by content
+// on their own). "unreadable" when /proc/self/exe cannot be read (every build then shares it).
 const std::string& running_binary_hash();
 
 // The part of the precompute and cost stores' keys that stands for the C++ computing what they hold:
-// a hash of the renderer libraries and libastcenc, taken when the iblcheck binary is built
-// (cmake/render_code_hash.cmake, cli/CMakeLists.txt). A change to the harness, the report or the CLI
+// the renderer libraries, the glslang/SPIRV-Tools archives and libastcenc, hashed when the iblcheck
+// binary is built (cmake/render_code_hash.cmake). A change to the harness, the report or the CLI
 // keeps it, so a nightly or a bisect step after such a change reads the entries an earlier build
-// made; a change to a renderer library (or a new libastcenc) is a miss. A binary built without the
-// hash (the test programs) uses running_binary_hash(), as every store did before (issue 33).
+// made; a change to a renderer library (or to one of those libraries) is a miss. A binary built
+// without it (the test programs) uses running_binary_hash(), as every store did before (issue 33).
 const std::string& render_code_hash();
 
 } // namespace iblcheck
