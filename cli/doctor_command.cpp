@@ -8,6 +8,7 @@
 #include <map>
 #include <set>
 
+#include "cli/store_folders.h"
 #include "harness/golden_store.h"
 #include "harness/provenance.h"
 #include "kernel/cpu_caps.h"
@@ -84,6 +85,11 @@ void register_doctor_command(CLI::App& app, int& exit_code) {
         fmt::print("shader folder:   {}\n", vk::shader_dir().string());
         // The precompute and cost stores' code key (program.h): what a rebuild keeps or misses.
         fmt::print("store code key:  {}\n", render_code_hash());
+        // How full the stores are against their budget (store_budget.h); the oldest go after a run that writes.
+        const StoreUsage use = store_usage(store_folders());
+        fmt::print(
+            "stores:          {} entries, {:.0f} MiB of a {} MiB budget (IBLCHECK_CACHE_MAX_MB; least recently used go first)\n",
+            use.entries, double(use.bytes) / (1 << 20), store_budget_bytes() >> 20);
         // What llvmpipe generates shader code for (lavapipe compiles for the host CPU); meaningful
         // when the driver is llvmpipe.
         LlvmpipeCaps caps = llvmpipe_caps();

@@ -1,14 +1,30 @@
 #include "kernel/store_entry.h"
 
+#include <atomic>
 #include <cstdlib>
 #include <fstream>
 #include <iterator>
 
 #include "kernel/atomic_file.h"
+#include "kernel/store_budget.h"
 
 namespace fs = std::filesystem;
 
 namespace iblcheck {
+
+namespace {
+std::atomic<bool> g_written{false};
+
+// An entry's modification time is its last use (store_budget.h): the least recently used go first.
+// Set from the fine clock (a write's own time comes from the kernel's coarse one); a failure (a
+// read-only store) only makes the entry look older.
+void mark_used(const fs::path& file) {
+    std::error_code ec;
+    fs::last_write_time(file, fs::file_time_type::clock::now(), ec);
+}
+} // namespace
+
+bool store_entries_written() { return g_written.load(std::memory_order_relaxed); }
 
 fs::path store_dir(const char* env_var, const fs::path& default_dir) {
     if (const char* dir = std::getenv(env_var); dir && *dir) return std::string(dir) == "0" ? fs::path() : fs::path(dir);
@@ -21,13 +37,16 @@ std::optional<std::string> read_store_entry(const fs::path& file, std::string_vi
     std::string bytes((std::istreambuf_iterator<char>(f)), {});
     if (bytes.size() < head.size() || bytes.compare(0, head.size(), head) != 0) return std::nullopt;
     bytes.erase(0, head.size());
+    mark_used(file);
     return bytes;
 }
 
 void write_store_entry(const fs::path& file, std::string_view bytes) {
     std::error_code ec;
     fs::create_directories(file.parent_path(), ec);
-    try_write_file_atomically(file, bytes); // a failure is no error: the next run does the work again
+    if (!try_write_file_atomically(file, bytes)) return; // no error: the next run does the work again
+    g_written.store(true, std::memory_order_relaxed);
+    mark_used(file);
 }
 
 } // namespace iblcheck

@@ -64,11 +64,15 @@ json to_json(const Accuracy& a) {
     return j;
 }
 Accuracy accuracy_from_json(const json& j) {
-    Accuracy a{number_or_nan(j, summary_name("flip.mean")), number_or_nan(j, summary_name("ssim.mean")), string_of(j, "golden"),
-               json_of(j, "noise_floor"), {}};
+    Accuracy a{number_or_nan(j, summary_name("flip.mean")),
+               number_or_nan(j, summary_name("ssim.mean")),
+               string_of(j, "golden"),
+               json_of(j, "noise_floor"),
+               {}};
     if (const json d = json_of(j, "display"); d.is_object())
         a.display = DisplayAccuracy{json_of(d, "space"), number_or_nan(d, summary_name("display_flip.mean")),
-                                    number_or_nan(d, summary_name("display_ssim.mean")), number_or_nan(d, summary_name("display_psnr.db"))};
+                                    number_or_nan(d, summary_name("display_ssim.mean")),
+                                    number_or_nan(d, summary_name("display_psnr.db"))};
     return a;
 }
 

@@ -205,9 +205,9 @@ TEST(ShaderCompiler, EveryPipelineShaderIsReusedFromTheCache) {
     vk::CompileOptions counted;
     counted.count_instructions = true;
     for (const vk::CompileOptions& options : {vk::CompileOptions{}, counted})
-        for (const char* s :
-             {"equirect_to_cube.comp", "downsample_cube.comp", "prefilter_ggx.comp", "sh9_project.comp", "irradiance_cube.comp",
-              "dfg_lut.comp", "encode_storage.comp", "shade_spheres.comp", "shade_sampled.comp", "shade_spheres.vert", "shade_spheres.frag"}) {
+        for (const char* s : {"equirect_to_cube.comp", "downsample_cube.comp", "prefilter_ggx.comp", "sh9_project.comp",
+                              "irradiance_cube.comp", "dfg_lut.comp", "encode_storage.comp", "shade_spheres.comp",
+                              "shade_sampled.comp", "shade_spheres.vert", "shade_spheres.frag"}) {
             const vk::Defines& d = std::string(s).find(".comp") == std::string::npos ? fragment_defaults : defaults;
             EXPECT_FALSE(vk::compile_shader(s, d, options).from_cache) << s;
             EXPECT_TRUE(vk::compile_shader(s, d, options).from_cache) << s << " (count: " << options.count_instructions << ")";
@@ -219,8 +219,9 @@ TEST(ShaderCompiler, AllPipelineShadersCompile) {
     // Every pass of renderers/shaders compiles in its default variant (the option table's defaults).
     vk::Defines defaults = glsl_defines(shader_selections(OptionMap{}, "mobile"));
     defaults.merge(glsl_defines(shader_selections(OptionMap{}, "sampled"))); // shade_sampled.comp's mip_clamp
-    for (const char* s : {"equirect_to_cube.comp", "downsample_cube.comp", "prefilter_ggx.comp", "sh9_project.comp",
-                          "irradiance_cube.comp", "dfg_lut.comp", "encode_storage.comp", "shade_spheres.comp", "shade_sampled.comp"}) {
+    for (const char* s :
+         {"equirect_to_cube.comp", "downsample_cube.comp", "prefilter_ggx.comp", "sh9_project.comp", "irradiance_cube.comp",
+          "dfg_lut.comp", "encode_storage.comp", "shade_spheres.comp", "shade_sampled.comp"}) {
         EXPECT_NO_THROW(vk::compile_compute_shader(s, defaults)) << s;
     }
 }

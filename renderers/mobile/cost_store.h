@@ -33,8 +33,7 @@ std::string shading_inputs_hash(GpuSession& gpu, const Environment& env, const P
 // The entry's name: a hash of `parts` (the pass's inputs), the device, driver and CPU class.
 // `tool`: the C++ that counts (program.h: render_code_hash, the renderer libraries of the build): the
 // counting pass's host side is C++.
-std::string cost_store_key(GpuSession& gpu, const std::vector<std::string>& parts,
-                           const std::string& tool = render_code_hash());
+std::string cost_store_key(GpuSession& gpu, const std::vector<std::string>& parts, const std::string& tool = render_code_hash());
 
 // A content hash of `n` bytes (push constants, output images) for a key part.
 std::string bytes_hash(const void* data, size_t n);
