@@ -85,6 +85,7 @@ void register_doctor_command(CLI::App& app, int& exit_code) {
         fmt::print("shader folder:   {}\n", vk::shader_dir().string());
         // The precompute and cost stores' code key (program.h): what a rebuild keeps or misses.
         fmt::print("store code key:  {}\n", render_code_hash());
+        fmt::print("metrics code key: {}\n", metrics_code_hash()); // the metrics store's (program.h)
         // How full the stores are against their budget (store_budget.h); the oldest go after a run that writes.
         const StoreUsage use = store_usage(store_folders());
         fmt::print(

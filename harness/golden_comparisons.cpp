@@ -35,35 +35,22 @@ void note_worst_block(Comparison& c, const SphereCoverage& coverage, const FlipR
                         sphere.empty() ? "" : " on " + sphere, display ? "LDR-FLIP on the display" : "FLIP", flip.block_max);
 }
 
-// The metrics of a render against a golden, computed. `linear` receives the HDR-FLIP result (the
-// accuracy and the per-sphere errors are linear figures); `shown`, the FLIP map that locates the
-// difference for the worst block and the heatmap: a display test's LDR-FLIP on its display (what its
-// tolerances judge), else the same HDR-FLIP.
-json compute_metrics(const TestCase& tc, const cv::Mat& golden, const cv::Mat& image, int flip_threads, FlipResult& linear,
-                     FlipResult& shown) {
-    json m = compare_images(golden, image, flip_threads, &linear);
-    if (!tc.display) {
-        shown = linear;
-        return m;
-    }
-    m.update(compare_in_display(golden, image, *tc.display, flip_threads, &shown));
-    return m;
-}
-
-// compute_metrics(), or what the metrics store (metrics_store.h) holds for the same two images, the
-// same display and this build. A render equal to its golden bit for bit is measured (at no cost).
+// measure_against_golden() (metrics/image_compare.h), or what the metrics store (metrics_store.h)
+// holds for the same two images, the same display and the same metric code. A render equal to its
+// golden bit for bit is measured (at no cost).
 json measure(const TestCase& tc, const cv::Mat& golden, const cv::Mat& image, int flip_threads, FlipResult& linear,
              FlipResult& shown) {
     ProfileStage stage("metrics"); // FLIP, SSIM, PSNR (and the display space's)
-    if (identical_finite(golden, image)) return compute_metrics(tc, golden, image, flip_threads, linear, shown);
-    const std::string key = metrics_store_key(golden, image, tc.display ? &*tc.display : nullptr);
+    const DisplaySpace* display = tc.display ? &*tc.display : nullptr;
+    if (identical_finite(golden, image)) return measure_against_golden(golden, image, display, flip_threads, linear, shown);
+    const std::string key = metrics_store_key(golden, image, display);
     if (std::optional<Measured> stored = load_measured(key)) {
         linear = std::move(stored->linear);
         shown = stored->shown ? std::move(*stored->shown) : linear;
         return std::move(stored->metrics);
     }
     Measured m;
-    m.metrics = compute_metrics(tc, golden, image, flip_threads, m.linear, shown);
+    m.metrics = measure_against_golden(golden, image, display, flip_threads, m.linear, shown);
     if (tc.display) m.shown = shown;
     save_measured(key, m);
     linear = std::move(m.linear);

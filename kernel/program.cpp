@@ -71,6 +71,17 @@ const std::string& render_code_hash() {
     return hash;
 }
 
+// The same for the metric code (its generated metrics_code_hash.cpp).
+extern "C" __attribute__((weak)) const char* iblcheck_metrics_code_hash_generated() { return nullptr; }
+
+const std::string& metrics_code_hash() {
+    static const std::string hash = [] {
+        const char* built = iblcheck_metrics_code_hash_generated();
+        return built && *built ? "metrics-code:" + std::string(built) : running_binary_hash();
+    }();
+    return hash;
+}
+
 const std::string& running_binary_hash() {
     static const std::string hash = [] {
         std::string h = file_content_hash("/proc/self/exe");

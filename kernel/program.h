@@ -19,9 +19,8 @@ std::string program_from_self();
 // The content hash (FNV-1a 64, hex) of the file at `path`; empty when it cannot be read.
 std::string file_content_hash(const std::string& path);
 
-// The running binary's content hash (/proc/self/exe), computed once: the metrics store's key part for
-// the tool's own C++ (harness/metrics_store.h), and the precompute and cost stores' where the binary
-// has no render_code_hash. Without it an entry made by another build of the tool was read back: a
+// The running binary's content hash (/proc/self/exe), computed once: the stores' key part for the
+// tool's own C++ where the binary has no render_code_hash or metrics_code_hash (the test programs). Without it an entry made by another build of the tool was read back: a
 // bisect across a C++ change, whose steps share .cache/, judged each commit with the first one's
 // precompute. A shader-only change relinks nothing and keeps the hash (shaders are keyed by content
 // on their own). "unreadable" when /proc/self/exe cannot be read (every build then shares it).
@@ -34,5 +33,12 @@ const std::string& running_binary_hash();
 // made; a change to a renderer library (or to one of those libraries) is a miss. A binary built
 // without it (the test programs) uses running_binary_hash(), as every store did before (issue 33).
 const std::string& render_code_hash();
+
+// The metrics store's counterpart (harness/metrics_store.h): the metric code, hashed when the
+// iblcheck binary is built from the metrics, metric catalog, metrics store, image and kernel
+// libraries and the OpenCV libraries SSIM and the display transform call (cmake/render_code_hash.cmake
+// with NAME=metrics). A change to the renderers, the rest of the harness, the report or the CLI
+// keeps it; running_binary_hash() in a binary built without it.
+const std::string& metrics_code_hash();
 
 } // namespace iblcheck

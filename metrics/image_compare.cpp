@@ -70,4 +70,15 @@ json compare_images(const cv::Mat& golden, const cv::Mat& test, int flip_threads
     return compare_images(golden, test, o, flip_out);
 }
 
+json measure_against_golden(const cv::Mat& golden, const cv::Mat& test, const DisplaySpace* display, int flip_threads,
+                            FlipResult& linear, FlipResult& shown) {
+    json m = compare_images(golden, test, flip_threads, &linear);
+    if (!display) {
+        shown = linear;
+        return m;
+    }
+    m.update(compare_in_display(golden, test, *display, flip_threads, &shown));
+    return m;
+}
+
 } // namespace iblcheck

@@ -44,4 +44,12 @@ nlohmann::json compare_images(const cv::Mat& golden, const cv::Mat& test, int fl
 nlohmann::json compare_in_display(const cv::Mat& golden, const cv::Mat& test, const DisplaySpace& display, int flip_threads,
                                   FlipResult* flip_out = nullptr);
 
+// A render against a golden as a run measures it (what the metrics store holds): the linear
+// comparison, and with a `display` (none: null) the same in that space beside it. `linear`
+// receives the HDR-FLIP result (the accuracy and the per-sphere errors are linear figures);
+// `shown`, the FLIP map that locates the difference for the worst block and the heatmap: a display
+// test's LDR-FLIP on its display (what its tolerances judge), else the same HDR-FLIP.
+nlohmann::json measure_against_golden(const cv::Mat& golden, const cv::Mat& test, const DisplaySpace* display, int flip_threads,
+                                      FlipResult& linear, FlipResult& shown);
+
 } // namespace iblcheck

@@ -1,9 +1,10 @@
 # Issue 33: the precompute and cost stores key on the renderer code's hash (kernel/program.h:
 # render_code_hash), which cmake/render_code_hash.cmake takes of the renderer libraries at build time.
 # Checks that the hash is the same for the same files, differs when one byte of one file changes,
-# refuses a missing file, and that the iblcheck binary's stores use the hash its build generated.
+# refuses a missing file, and that the iblcheck binary's stores use the hashes its build generated
+# (the renderer code's, and the metric code's for the metrics store: kernel/program.h).
 #   cmake -DIBLCHECK=iblcheck -DSCRIPT=cmake/render_code_hash.cmake -DGENERATED=build/cli/render_code_hash.cpp
-#         -DOUT=dir -P check_render_code_hash.cmake
+#         -DGENERATED_METRICS=build/cli/metrics_code_hash.cpp -DOUT=dir -P check_render_code_hash.cmake
 file(REMOVE_RECURSE "${OUT}")
 file(MAKE_DIRECTORY "${OUT}")
 file(WRITE "${OUT}/a.a" "the first library's bytes")
@@ -33,12 +34,30 @@ endif()
 if(NOT missing MATCHES "^failed: .*missing\\.a")
   message(FATAL_ERROR "a missing library was not refused: '${missing}'")
 endif()
-# The binary: `doctor` names the key its stores use, which is the hash its build generated.
-file(READ "${GENERATED}" generated)
-string(REGEX MATCH "return \"([0-9a-f]+)\"" _ "${generated}")
-set(built "${CMAKE_MATCH_1}")
-execute_process(COMMAND "${IBLCHECK}" doctor OUTPUT_VARIABLE doctor ERROR_VARIABLE doctor_err RESULT_VARIABLE rc)
-if(NOT doctor MATCHES "store code key: +render-code:${built}\n")
-  message(FATAL_ERROR "iblcheck doctor does not give the generated render code hash ${built}:\n${doctor}${doctor_err}")
+# NAME names the function generated: the metrics store's own (metrics_code_hash).
+execute_process(COMMAND "${CMAKE_COMMAND}" "-DFILES=${OUT}/a.a" "-DOUT=${OUT}/metrics.cpp" -DNAME=metrics -P "${SCRIPT}"
+                RESULT_VARIABLE rc)
+file(READ "${OUT}/metrics.cpp" metrics_text)
+if(NOT rc EQUAL 0 OR NOT metrics_text MATCHES "iblcheck_metrics_code_hash_generated\\(\\) { return \"[0-9a-f]+\"")
+  message(FATAL_ERROR "NAME=metrics did not generate iblcheck_metrics_code_hash_generated:\n${metrics_text}")
 endif()
-message("render code hash: ${first} -> ${changed} after one byte; the binary's stores use ${built}")
+# The binary: `doctor` names the keys its stores use, which are the hashes its build generated.
+execute_process(COMMAND "${IBLCHECK}" doctor OUTPUT_VARIABLE doctor ERROR_VARIABLE doctor_err RESULT_VARIABLE rc)
+set(report "")
+foreach(store render metrics)
+  if(store STREQUAL render)
+    set(file "${GENERATED}")
+    set(line "store code key")
+  else()
+    set(file "${GENERATED_METRICS}")
+    set(line "metrics code key")
+  endif()
+  file(READ "${file}" generated)
+  string(REGEX MATCH "iblcheck_${store}_code_hash_generated\\(\\) { return \"([0-9a-f]+)\"" _ "${generated}")
+  set(built "${CMAKE_MATCH_1}")
+  if(built STREQUAL "" OR NOT doctor MATCHES "${line}: +${store}-code:${built}\n")
+    message(FATAL_ERROR "iblcheck doctor does not give the generated ${store} code hash '${built}' (${file}):\n${doctor}${doctor_err}")
+  endif()
+  string(APPEND report " ${store}-code:${built}")
+endforeach()
+message("code hash: ${first} -> ${changed} after one byte; the binary's stores use${report}")

@@ -410,6 +410,7 @@ TEST(PrecomputeStore, ToolPartIsTheRunningBinarysContent) {
     // its build generated (stores.render_code_hash checks that); in a program built without it, like
     // this one, the running binary's content.
     EXPECT_EQ(render_code_hash(), running_binary_hash());
+    EXPECT_EQ(metrics_code_hash(), running_binary_hash()); // the metrics store's, the same way
 
     const fs::path dir = temp_dir("tool_hash");
     std::string copy = bytes.substr(0, 4096);
