@@ -59,26 +59,25 @@ std::string file_content_hash(const std::string& path) {
     return f.bad() ? "" : h.hex();
 }
 
-// Defined by the iblcheck binary (its generated render_code_hash.cpp); this weak one stands in for it
-// in every other program.
+// Defined by the iblcheck binary (its generated render_code_hash.cpp and metrics_code_hash.cpp);
+// these weak ones stand in for them in every other program.
 extern "C" __attribute__((weak)) const char* iblcheck_render_code_hash_generated() { return nullptr; }
+extern "C" __attribute__((weak)) const char* iblcheck_metrics_code_hash_generated() { return nullptr; }
+
+namespace {
+// "<kind>-code:<hash>" when the build generated the hash, else the running binary's.
+std::string code_hash(const char* kind, const char* built) {
+    return built && *built ? std::string(kind) + "-code:" + built : running_binary_hash();
+}
+} // namespace
 
 const std::string& render_code_hash() {
-    static const std::string hash = [] {
-        const char* built = iblcheck_render_code_hash_generated();
-        return built && *built ? "render-code:" + std::string(built) : running_binary_hash();
-    }();
+    static const std::string hash = code_hash("render", iblcheck_render_code_hash_generated());
     return hash;
 }
 
-// The same for the metric code (its generated metrics_code_hash.cpp).
-extern "C" __attribute__((weak)) const char* iblcheck_metrics_code_hash_generated() { return nullptr; }
-
 const std::string& metrics_code_hash() {
-    static const std::string hash = [] {
-        const char* built = iblcheck_metrics_code_hash_generated();
-        return built && *built ? "metrics-code:" + std::string(built) : running_binary_hash();
-    }();
+    static const std::string hash = code_hash("metrics", iblcheck_metrics_code_hash_generated());
     return hash;
 }
 
