@@ -17,6 +17,7 @@
 #include "kernel/program.h"
 #include "kernel/shell_quote.h"
 #include "kernel/store_budget.h"
+#include "kernel/store_entry.h"
 
 namespace {
 

@@ -2,9 +2,10 @@
 # iblcheck binary:
 #   cmake -DFILES="a.a|b.a|libastcenc.so" -DOUT=render_code_hash.cpp [-DNAME=render] -P render_code_hash.cmake
 # FILES: the libraries whose code computes what the stores hold (NAME=render: the precompute and
-# cost stores, with libastcenc; NAME=metrics: the metrics store, with OpenCV's shared libraries). Each is hashed whole (SHA-256): Debian's ar writes deterministic archives (no dates),
-# so the same code gives the same hash, and any change to it (a source, a header it includes, a
-# flag, the compiler) changes its objects and so the hash.
+# cost stores, with libastcenc; NAME=metrics: the metrics store, with OpenCV's shared libraries).
+# Each is hashed whole (SHA-256): Debian's ar writes deterministic archives (no dates), so the same
+# code gives the same hash, and any change to it (a source, a header it includes, a flag, the
+# compiler) changes its objects and so the hash.
 if(NOT DEFINED NAME)
   set(NAME render)
 endif()

@@ -20,10 +20,11 @@ std::string program_from_self();
 std::string file_content_hash(const std::string& path);
 
 // The running binary's content hash (/proc/self/exe), computed once: the stores' key part for the
-// tool's own C++ where the binary has no render_code_hash or metrics_code_hash (the test programs). Without it an entry made by another build of the tool was read back: a
-// bisect across a C++ change, whose steps share .cache/, judged each commit with the first one's
-// precompute. A shader-only change relinks nothing and keeps the hash (shaders are keyed by content
-// on their own). "unreadable" when /proc/self/exe cannot be read (every build then shares it).
+// tool's own C++ where the binary has no render_code_hash or metrics_code_hash (the test programs).
+// Without it an entry made by another build of the tool was read back: a bisect across a C++
+// change, whose steps share .cache/, judged each commit with the first one's precompute. A
+// shader-only change relinks nothing and keeps the hash (shaders are keyed by content on their
+// own). "unreadable" when /proc/self/exe cannot be read (every build then shares it).
 const std::string& running_binary_hash();
 
 // The part of the precompute and cost stores' keys that stands for the C++ computing what they hold:

@@ -63,19 +63,20 @@ std::vector<Entry> list_entries(const std::vector<StoreFolder>& folders) {
     return out;
 }
 
-} // namespace
-
-StoreUsage store_usage(const std::vector<StoreFolder>& folders) {
+StoreUsage usage_of(const std::vector<Entry>& entries) {
     StoreUsage u;
-    for (const Entry& e : list_entries(folders)) ++u.entries, u.bytes += e.bytes;
+    for (const Entry& e : entries) ++u.entries, u.bytes += e.bytes;
     return u;
 }
+
+} // namespace
+
+StoreUsage store_usage(const std::vector<StoreFolder>& folders) { return usage_of(list_entries(folders)); }
 
 PruneOutcome prune_stores(const std::vector<StoreFolder>& folders, std::uintmax_t budget, fs::file_time_type keep_since) {
     std::vector<Entry> entries = list_entries(folders);
     PruneOutcome o;
-    for (const Entry& e : entries) ++o.before.entries, o.before.bytes += e.bytes;
-    o.after = o.before;
+    o.before = o.after = usage_of(entries);
     if (o.before.bytes <= budget) return o;
     // Oldest use first; the path breaks ties so that the order does not depend on the folder's.
     std::sort(entries.begin(), entries.end(),

@@ -58,8 +58,4 @@ StoreUsage store_usage(const std::vector<StoreFolder>& folders);
 PruneOutcome prune_stores(const std::vector<StoreFolder>& folders, std::uintmax_t budget,
                           std::filesystem::file_time_type keep_since);
 
-// Whether this process has written a store entry (write_store_entry): only then can the stores
-// have grown, so only then does a command prune them.
-bool store_entries_written();
-
 } // namespace iblcheck

@@ -6,7 +6,6 @@
 #include <iterator>
 
 #include "kernel/atomic_file.h"
-#include "kernel/store_budget.h"
 
 namespace fs = std::filesystem;
 

@@ -21,4 +21,8 @@ std::optional<std::string> read_store_entry(const std::filesystem::path& file, s
 // whole entry or none), creating the folder; a failure to write is ignored.
 void write_store_entry(const std::filesystem::path& file, std::string_view bytes);
 
+// Whether this process has written a store entry: only then can the stores have grown, so only then
+// does a command prune them (store_budget.h).
+bool store_entries_written();
+
 } // namespace iblcheck

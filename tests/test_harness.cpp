@@ -312,11 +312,11 @@ TEST(Gate, ShaderChangeFailsExactlyTheAffectedCiTestsAndBisectFollowsTheContract
     const fs::path stores = std::getenv("IBLCHECK_CACHE_DIR") ? fs::path(std::getenv("IBLCHECK_CACHE_DIR"))
                                                               : fs::path(IBLCHECK_SOURCE_DIR) / ".cache";
     std::string env = "IBLCHECK_CACHE_DIR=" + dir.string() + " IBLCHECK_SHADER_DIR=" + (dir / "shaders").string() + " ";
-    for (const char* store : {"precompute", "cost", "metrics"}) {
-        std::string var = std::string("IBLCHECK_") + store + "_CACHE";
-        for (char& ch : var) ch = char(std::toupper(static_cast<unsigned char>(ch)));
-        const char* set = std::getenv(var.c_str()); // a store the caller placed or turned off stays so
-        env += var + "=" + shell_quote(set ? std::string(set) : (stores / store).string()) + " ";
+    for (const auto& [var, folder] : {std::pair{"IBLCHECK_PRECOMPUTE_CACHE", "precompute"},
+                                      {"IBLCHECK_COST_CACHE", "cost"},
+                                      {"IBLCHECK_METRICS_CACHE", "metrics"}}) {
+        const char* set = std::getenv(var); // a store the caller placed or turned off stays so
+        env += std::string(var) + "=" + shell_quote(set ? std::string(set) : (stores / folder).string()) + " ";
     }
     std::string out;
     int rc = run_command(env + iblcheck_bin() + " run --suite ci -q --json " + (dir / "bad.json").string(), out);

@@ -4,8 +4,9 @@
 // Its name is a hash of every input: the environment's pixels (content hash), every setting, the
 // sources of the passes' shaders and what they include, the device and driver (Mesa, LLVM) and
 // llvmpipe's CPU class (its generated code can round differently), and the renderer libraries' code
-// (program.h: render_code_hash; a build with other renderer code or another libastcenc misses). A changed input is a miss, and
-// a damaged entry is computed again. IBLCHECK_PRECOMPUTE_CACHE=0 turns it off; =DIR puts it there.
+// (program.h: render_code_hash; a build with other renderer code or another libastcenc misses). A
+// changed input is a miss, and a damaged entry is computed again. IBLCHECK_PRECOMPUTE_CACHE=0 turns
+// it off; =DIR puts it there.
 #pragma once
 #include <filesystem>
 #include <optional>
