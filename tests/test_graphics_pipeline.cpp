@@ -12,6 +12,7 @@
 #include "kernel/errors.h"
 #include "renderers/vulkan/graphics_pipeline.h"
 #include "renderers/vulkan/spirv_cost.h"
+#include "tests/test_support.h"
 
 namespace fs = std::filesystem;
 using namespace iblcheck;
@@ -20,8 +21,7 @@ namespace {
 
 fs::path temp_dir() {
     static fs::path p = [] {
-        fs::path d = fs::temp_directory_path() / ("iblcheck_test_graphics_" + std::to_string(::getpid()));
-        fs::create_directories(d);
+        fs::path d = testutil::temp_dir("test_graphics");
         setenv("IBLCHECK_CACHE_DIR", (d / "cache").c_str(), 1); // a private SPIR-V cache
         return d;
     }();

@@ -12,6 +12,7 @@
 #include "renderers/environments/procedural.h"
 #include "renderers/scenes/coverage.h"
 #include "renderers/scenes/scene.h"
+#include "tests/test_support.h"
 
 using namespace iblcheck;
 namespace fs = std::filesystem;
@@ -20,8 +21,7 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 
 fs::path temp_file(const std::string& name) {
-    fs::path dir = fs::temp_directory_path() / ("iblcheck_test_env_" + std::to_string(::getpid()));
-    fs::create_directories(dir);
+    static const fs::path dir = testutil::temp_dir("test_env");
     return dir / name;
 }
 

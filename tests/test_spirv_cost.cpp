@@ -14,6 +14,7 @@
 #include "kernel/errors.h"
 #include "renderers/vulkan/context.h"
 #include "renderers/vulkan/spirv_cost.h"
+#include "tests/test_support.h"
 
 namespace fs = std::filesystem;
 using namespace iblcheck;
@@ -28,8 +29,7 @@ const vk::CompileOptions kCounted = [] {
 
 fs::path temp_dir() {
     static fs::path p = [] {
-        fs::path d = fs::temp_directory_path() / ("iblcheck_test_spirv_cost_" + std::to_string(::getpid()));
-        fs::create_directories(d);
+        fs::path d = testutil::temp_dir("test_spirv_cost");
         // A private SPIR-V cache: earlier runs' entries cannot answer for this one.
         setenv("IBLCHECK_CACHE_DIR", (d / "cache").c_str(), 1);
         return d;
