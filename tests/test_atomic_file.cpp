@@ -24,6 +24,9 @@
 namespace fs = std::filesystem;
 using namespace iblcheck;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace test_atomic_file {
+
 namespace {
 
 class AtomicFile : public ::testing::Test {
@@ -135,3 +138,4 @@ TEST_F(AtomicFile, AGoldenWithoutAFolderIsWrittenInTheCurrentOne) {
     fs::current_path(was);
     EXPECT_EQ(names(), (std::set<std::string>{"g.exr", "g.json"}));
 }
+} // namespace test_atomic_file

@@ -22,6 +22,9 @@ namespace fs = std::filesystem;
 using namespace iblcheck;
 using namespace iblcheck::testutil;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace test_display_space {
+
 // IEEE binary16: 10 mantissa bits, largest 65504, subnormals down to 2^-24; ties to even.
 TEST(DisplaySpace, HalfRoundingOfKnownValues) {
     EXPECT_EQ(round_to_half(1.0f), 1.0f);
@@ -372,3 +375,4 @@ TEST(DisplayChart, PanelsPlotLinearAgainstDisplayAndStateTheRankChange) {
     EXPECT_NE(one.find("No scene, environment and space has two tests scored in it."), std::string::npos) << one;
     EXPECT_EQ(one.find("data-chart="), std::string::npos) << one;
 }
+} // namespace test_display_space

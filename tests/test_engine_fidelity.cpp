@@ -24,6 +24,9 @@
 using namespace iblcheck;
 using namespace iblcheck::testutil;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace test_engine_fidelity {
+
 namespace {
 
 // common.glsl's cube_direction (Vulkan layer order +X −X +Y −Y +Z −Z; t down) at a texel centre.
@@ -279,3 +282,4 @@ TEST(EngineFidelity, EveryVariantGetsItsWhiteFurnaceFigure) {
     truth.spec.method = "reference";
     EXPECT_TRUE(furnace_figure(truth, w, store).is_null()); // the truth has none
 }
+} // namespace test_engine_fidelity

@@ -15,6 +15,9 @@
 
 using namespace iblcheck;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace test_error_budget {
+
 namespace {
 std::vector<std::string> keys(const std::vector<BudgetRung>& rungs) {
     std::vector<std::string> k;
@@ -158,3 +161,4 @@ TEST(ErrorBudget, SplitSumRungsInTheWhiteFurnaceHaveTheirIndependentFigures) {
     EXPECT_NEAR(exact.at<cv::Vec3f>(cy, cx)[1], 0.30685, 2e-3);
     EXPECT_NEAR(approx.at<cv::Vec3f>(cy, cx)[1], 0.4500, 2e-3);
 }
+} // namespace test_error_budget

@@ -26,11 +26,12 @@ namespace fs = std::filesystem;
 using namespace iblcheck;
 using nlohmann::json;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace test_gate_holes {
+
 namespace {
 
 using namespace iblcheck::testutil;
-
-std::string bin(const std::string& name) { return std::string(IBLCHECK_BINARY_DIR) + "/" + name; }
 
 const char* kMiniSuite = R"({
   "suite": "mini",
@@ -53,7 +54,7 @@ struct MiniStore : FurnaceStore {
         return run_suite(o);
     }
     std::string cli(const std::string& args) const {
-        return bin("iblcheck") + " " + args + " --suite " + suite.string() + " --goldens " + goldens.string();
+        return built("iblcheck") + " " + args + " --suite " + suite.string() + " --goldens " + goldens.string();
     }
 };
 
@@ -115,7 +116,7 @@ TEST(GateHoles, GoldenOfTheWrongSizeFailsWithBothSizesAndTheReportIsStillWritten
     EXPECT_TRUE(fs::exists(out / "results.json"));
     EXPECT_TRUE(fs::exists(out / "index.html"));
     std::string report_out;
-    EXPECT_EQ(run_command(bin("iblcheck") + " report " + (out / "results.json").string() + " --out " + (s.dir / "rep").string(),
+    EXPECT_EQ(run_command(built("iblcheck") + " report " + (out / "results.json").string() + " --out " + (s.dir / "rep").string(),
                           report_out),
               0)
         << report_out;
@@ -128,16 +129,16 @@ TEST(GateHoles, ShaderThatWritesNanIsARegressionForRunBisectAndRender) {
                                        "sum / float(n * n) * uintBitsToFloat(0x7fc00000u); // a quiet NaN");
     std::string out;
     const std::string filter = " --filter 'mobile.roughness_sweep.studio.default'";
-    EXPECT_EQ(run_command(env + bin("iblcheck") + " run --suite ci -q --json " + (dir / "r.json").string() + filter, out), 1)
+    EXPECT_EQ(run_command(env + built("iblcheck") + " run --suite ci -q --json " + (dir / "r.json").string() + filter, out), 1)
         << out;
     json r = json::parse(read_text(dir / "r.json"));
     EXPECT_EQ(r["tests"][0]["verdict"], "fail");
     EXPECT_NE(r["tests"][0]["message"].get<std::string>().find("non-finite value(s) (NaN/Inf), first at x=0, y=0"),
               std::string::npos)
         << r["tests"][0]["message"];
-    EXPECT_EQ(run_command(env + bin("iblcheck") + " bisect" + filter, out), 1) << out;
+    EXPECT_EQ(run_command(env + built("iblcheck") + " bisect" + filter, out), 1) << out;
     EXPECT_NE(out.find("bisect verdict: bad"), std::string::npos) << out;
-    EXPECT_EQ(run_command(env + bin("iblcheck") + " render --scene sphere --out " + (dir / "nan.exr").string(), out), 1) << out;
+    EXPECT_EQ(run_command(env + built("iblcheck") + " render --scene sphere --out " + (dir / "nan.exr").string(), out), 1) << out;
     EXPECT_NE(out.find("non-finite"), std::string::npos) << out;
     EXPECT_TRUE(fs::exists(dir / "nan.exr")); // written first, to be inspected
     fs::remove_all(dir);
@@ -158,7 +159,7 @@ TEST(GateHoles, BlessLeavesUnchangedGoldensUntouchedAndPrintsOnlyAfterWriting) {
     fs::create_directories(broken);
     fs::copy(s.goldens / "reference", broken / "reference", fs::copy_options::recursive); // the truth the test asks for
     std::ofstream(broken / "baseline") << "a file where the folder should be";
-    EXPECT_EQ(run_command(bin("iblcheck") + " bless --suite " + s.suite.string() + " --goldens " + broken.string(), out), 2)
+    EXPECT_EQ(run_command(built("iblcheck") + " bless --suite " + s.suite.string() + " --goldens " + broken.string(), out), 2)
         << out;
     EXPECT_EQ(out.find("\nblessed"), std::string::npos) << out;
     EXPECT_NE(out.rfind("blessed", 0), 0u) << out;
@@ -195,7 +196,7 @@ TEST(GateHoles, BlessCommandPrintedForASuiteGivenByPathWorks) {
     ASSERT_EQ(cmd.rfind("iblcheck ", 0), 0u);
     // The command names the golden store the run used (a run with --goldens prints it), so it runs as printed.
     EXPECT_NE(cmd.find(" --goldens " + s.goldens.string()), std::string::npos) << cmd;
-    EXPECT_EQ(run_command("cd / && " + bin("iblcheck") + cmd.substr(8), out), 0) << out;
+    EXPECT_EQ(run_command("cd / && " + built("iblcheck") + cmd.substr(8), out), 0) << out;
     EXPECT_TRUE(fs::exists(s.baseline()));
 }
 
@@ -217,7 +218,7 @@ TEST(GateHoles, CtestFormNeverPassesWithoutRunning) {
     // The ci suite as GoogleTest cases: names with ':' used to match no filter and pass, shards > 0
     // used to run nothing and pass, and a filter matching nothing passed.
     std::string out;
-    const std::string ci = bin("tests/test_suite_ci");
+    const std::string ci = built("tests/test_suite_ci");
     EXPECT_EQ(run_command(ci + " --gtest_filter=ci.no_such_test", out), 1) << out;
     EXPECT_NE(out.find("ran no test"), std::string::npos) << out;
     // A golden root with the truth the tests ask for and no baselines (a wrong root is an input
@@ -250,7 +251,7 @@ TEST(GateHoles, TwiceAsMuchShadingWorkFailsOnCostAndTheFigureIsDeterministic) {
                          "{ vec2 p = vec2(px) + (vec2(i, j) + 0.5) / float(n); sum += 0.5 * (shade_ray(p) + shade_ray(p)); }");
     std::string out;
     const std::string filter = " --filter 'mobile.roughness_sweep.*.default'";
-    EXPECT_EQ(run_command(env + bin("iblcheck") + " run --suite ci -q --json " + (dir / "r.json").string() + filter, out), 1)
+    EXPECT_EQ(run_command(env + built("iblcheck") + " run --suite ci -q --json " + (dir / "r.json").string() + filter, out), 1)
         << out;
     json r = json::parse(read_text(dir / "r.json"));
     ASSERT_EQ(r["tests"].size(), 2u);
@@ -263,10 +264,11 @@ TEST(GateHoles, TwiceAsMuchShadingWorkFailsOnCostAndTheFigureIsDeterministic) {
     }
     // Unchanged shaders: the same figure on every run (it counts SPIR-V, not time).
     json a, b;
-    ASSERT_EQ(run_command(bin("iblcheck") + " run --suite ci -q --json " + (dir / "a.json").string() + filter, out), 0) << out;
-    ASSERT_EQ(run_command(bin("iblcheck") + " run --suite ci -q --json " + (dir / "b.json").string() + filter, out), 0) << out;
+    ASSERT_EQ(run_command(built("iblcheck") + " run --suite ci -q --json " + (dir / "a.json").string() + filter, out), 0) << out;
+    ASSERT_EQ(run_command(built("iblcheck") + " run --suite ci -q --json " + (dir / "b.json").string() + filter, out), 0) << out;
     a = json::parse(read_text(dir / "a.json"));
     b = json::parse(read_text(dir / "b.json"));
     for (size_t i = 0; i < 2; ++i) EXPECT_EQ(a["tests"][i]["cost"], b["tests"][i]["cost"]);
     fs::remove_all(dir);
 }
+} // namespace test_gate_holes

@@ -30,16 +30,18 @@ namespace fs = std::filesystem;
 using namespace iblcheck;
 using nlohmann::json;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace test_harness {
+
 namespace {
 
 using namespace iblcheck::testutil;
 
-std::string iblcheck_bin() { return std::string(IBLCHECK_BINARY_DIR) + "/iblcheck"; }
 // The binary as the commands it prints name it from this folder (kernel/program.h): its relative
 // path when shorter than the absolute one (it is not on PATH here).
 std::string printed_bin() {
-    const std::string rel = fs::path(iblcheck_bin()).lexically_relative(fs::current_path()).string();
-    return rel.size() < iblcheck_bin().size() ? rel : iblcheck_bin();
+    const std::string rel = fs::path(built("iblcheck")).lexically_relative(fs::current_path()).string();
+    return rel.size() < built("iblcheck").size() ? rel : built("iblcheck");
 }
 
 std::string error_of(const fs::path& suite) {
@@ -319,7 +321,7 @@ TEST(Gate, ShaderChangeFailsExactlyTheAffectedCiTestsAndBisectFollowsTheContract
         env += std::string(var) + "=" + shell_quote(set ? std::string(set) : (stores / folder).string()) + " ";
     }
     std::string out;
-    int rc = run_command(env + iblcheck_bin() + " run --suite ci -q --json " + (dir / "bad.json").string(), out);
+    int rc = run_command(env + built("iblcheck") + " run --suite ci -q --json " + (dir / "bad.json").string(), out);
     EXPECT_EQ(rc, 1) << out;
     std::ifstream in(dir / "bad.json");
     json r = json::parse(in);
@@ -350,7 +352,7 @@ TEST(Gate, ShaderChangeFailsExactlyTheAffectedCiTestsAndBisectFollowsTheContract
 
     // Without -q, each failure says what failed, where (the sphere), what it did to the accuracy
     // against the truth (approved -> now) and the command that approves it.
-    rc = run_command(env + iblcheck_bin() + " run --suite ci --filter 'mobile.roughness_sweep.studio.default'", out);
+    rc = run_command(env + built("iblcheck") + " run --suite ci --filter 'mobile.roughness_sweep.studio.default'", out);
     EXPECT_EQ(rc, 1) << out;
     EXPECT_TRUE(std::regex_search(out, std::regex(R"(\n +baseline: flip\.mean [0-9.e-]+ > 0\.001 \(\+)"))) << out;
     EXPECT_TRUE(std::regex_search(
@@ -374,36 +376,36 @@ TEST(Gate, ShaderChangeFailsExactlyTheAffectedCiTestsAndBisectFollowsTheContract
     // suite.* tests (one a ci test), portability.* and goldens.bless_dry_run_changes_nothing of the
     // same CTest run check, so this test no longer runs it once more (issue 33).
     const std::string filter = " bisect --filter 'mobile.roughness_sweep.studio.default'";
-    EXPECT_EQ(run_command(iblcheck_bin() + filter, out), 0) << out;
-    EXPECT_EQ(run_command(env + iblcheck_bin() + filter, out), 1) << out;
+    EXPECT_EQ(run_command(built("iblcheck") + filter, out), 0) << out;
+    EXPECT_EQ(run_command(env + built("iblcheck") + filter, out), 1) << out;
     std::ofstream(f, std::ios::app) << "\nnot glsl at all;\n";
-    EXPECT_EQ(run_command(env + iblcheck_bin() + filter, out), 125) << out;
+    EXPECT_EQ(run_command(env + built("iblcheck") + filter, out), 125) << out;
     fs::remove_all(dir);
 }
 
 TEST(Cli, BadInputExitsTwo) {
     std::string out;
-    EXPECT_EQ(run_command(iblcheck_bin() + " run --suite no_such_suite", out), 2);
+    EXPECT_EQ(run_command(built("iblcheck") + " run --suite no_such_suite", out), 2);
     EXPECT_NE(out.find("no such suite"), std::string::npos) << out;
-    EXPECT_EQ(run_command(iblcheck_bin() + " render --scene nope", out), 2);
+    EXPECT_EQ(run_command(built("iblcheck") + " render --scene nope", out), 2);
     EXPECT_NE(out.find("valid scenes"), std::string::npos) << out;
-    EXPECT_EQ(run_command(iblcheck_bin() + " render --scene sphere --set roughness=abc", out), 2);
+    EXPECT_EQ(run_command(built("iblcheck") + " render --scene sphere --set roughness=abc", out), 2);
     EXPECT_NE(out.find("roughness"), std::string::npos) << out;
-    EXPECT_EQ(run_command(iblcheck_bin() + " render --scene sphere --env /nonexistent.exr", out), 2);
+    EXPECT_EQ(run_command(built("iblcheck") + " render --scene sphere --env /nonexistent.exr", out), 2);
     EXPECT_NE(out.find("/nonexistent.exr"), std::string::npos) << out;
-    EXPECT_EQ(run_command(iblcheck_bin() + " run --suite ci --filter 'nothing*'", out), 2);
+    EXPECT_EQ(run_command(built("iblcheck") + " run --suite ci --filter 'nothing*'", out), 2);
     // Issue 18's options: unknown values, a chain too short for a 2D layout's border, AO out of range.
-    EXPECT_EQ(run_command(iblcheck_bin() + " render --scene sphere --set env_layout=sphere", out), 2);
+    EXPECT_EQ(run_command(built("iblcheck") + " render --scene sphere --set env_layout=sphere", out), 2);
     EXPECT_NE(out.find("env_layout"), std::string::npos) << out;
-    EXPECT_EQ(run_command(iblcheck_bin() + " render --scene sphere --set storage=astc_hdr --set astc_block=5x5", out), 2);
+    EXPECT_EQ(run_command(built("iblcheck") + " render --scene sphere --set storage=astc_hdr --set astc_block=5x5", out), 2);
     EXPECT_NE(out.find("astc_block"), std::string::npos) << out;
-    EXPECT_EQ(run_command(iblcheck_bin() + " render --scene sphere --set env_layout=octahedral --set mips=8", out), 2);
+    EXPECT_EQ(run_command(built("iblcheck") + " render --scene sphere --set env_layout=octahedral --set mips=8", out), 2);
     EXPECT_NE(out.find("mips <= 7"), std::string::npos) << out;
     // Issue 27: a chain that stops short of r = 1 (UE4's curve reaches it at mip log2(size) − 2; the
     // old fixed 7 levels of a 512 cube ended at r ≈ 0.31 and made 512 look worse than 128).
-    EXPECT_EQ(run_command(iblcheck_bin() + " render --scene sphere --set cube_size=512 --set mips=7", out), 2);
+    EXPECT_EQ(run_command(built("iblcheck") + " render --scene sphere --set cube_size=512 --set mips=7", out), 2);
     EXPECT_NE(out.find("end at roughness 0.561, not 1"), std::string::npos) << out;
-    EXPECT_EQ(run_command(iblcheck_bin() + " render --scene sphere --set ao=2", out), 2);
+    EXPECT_EQ(run_command(built("iblcheck") + " render --scene sphere --set ao=2", out), 2);
     EXPECT_NE(out.find("'ao'"), std::string::npos) << out;
 }
 
@@ -412,9 +414,9 @@ TEST(Cli, RenderReportsTheEnvironmentTexture) {
     // (8 levels: the chain reaches r = 1, issue 27; ASTC 4x4: 16 bytes a block, one block each for
     // the 4², 2² and 1² levels).
     std::string out;
-    ASSERT_EQ(
-        run_command(iblcheck_bin() + " render --scene sphere --env constant:1 --set storage=astc_hdr --json - 2>/dev/null", out),
-        0)
+    ASSERT_EQ(run_command(
+                  built("iblcheck") + " render --scene sphere --env constant:1 --set storage=astc_hdr --json - 2>/dev/null", out),
+              0)
         << out;
     auto j = nlohmann::json::parse(out.substr(out.find('{')));
     EXPECT_EQ(j["texture_bytes"].get<uint64_t>(), 6u * 16 * (1024 + 256 + 64 + 16 + 4 + 1 + 1 + 1));
@@ -427,8 +429,8 @@ TEST(Cli, RenderReportsTheEnvironmentTexture) {
 TEST(Suites, TemporalAndStabilitySuitesPass) {
     // issue 7 and issue 9: the shipped suites pass on lavapipe (bands, claims, margins, determinism).
     std::string out;
-    EXPECT_EQ(run_command(iblcheck_bin() + " run --suite temporal", out), 0) << out;
-    EXPECT_EQ(run_command(iblcheck_bin() + " run --suite stability", out), 0) << out;
+    EXPECT_EQ(run_command(built("iblcheck") + " run --suite temporal", out), 0) << out;
+    EXPECT_EQ(run_command(built("iblcheck") + " run --suite stability", out), 0) << out;
     EXPECT_NE(out.find("0 fail"), std::string::npos) << out;
 }
 
@@ -442,7 +444,7 @@ TEST(Suites, ExploreWinnersHoldTheirBaselinesAndAccuracy) {
         GTEST_SKIP() << "blender:sunrise not present (" << err.what() << ")";
     }
     std::string out;
-    EXPECT_EQ(run_command(iblcheck_bin() + " run --suite explore_winners", out), 0) << out;
+    EXPECT_EQ(run_command(built("iblcheck") + " run --suite explore_winners", out), 0) << out;
     EXPECT_NE(out.find("3 tests: 3 pass"), std::string::npos) << out;
 }
 
@@ -578,3 +580,4 @@ TEST(Suite, NightlyAppendsToAHistoryBesideItsOutputByDefault) {
     }
     fs::remove_all(dir);
 }
+} // namespace test_harness

@@ -24,9 +24,10 @@ using namespace iblcheck;
 using namespace iblcheck::testutil;
 using nlohmann::json;
 
-namespace {
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace test_hostile_bless {
 
-std::string bin(const std::string& name) { return std::string(IBLCHECK_BINARY_DIR) + "/" + name; }
+namespace {
 
 const std::string& kMiniTest = kFurnaceTest;
 
@@ -121,7 +122,7 @@ TEST(HostileBless, ASecondBlessWaitsForTheFirstAndSaysSo) {
     ASSERT_GE(fd, 0);
     ASSERT_EQ(::flock(fd, LOCK_EX), 0); // as a running bless holds it
     FILE* p = popen(
-        (bin("iblcheck") + " bless --suite " + s.suite.string() + " --goldens " + s.goldens.string() + " 2>&1").c_str(), "r");
+        (built("iblcheck") + " bless --suite " + s.suite.string() + " --goldens " + s.goldens.string() + " 2>&1").c_str(), "r");
     ASSERT_NE(p, nullptr);
     std::string first;
     char buf[4096];
@@ -199,3 +200,4 @@ TEST(HostileBless, PrintedCommandsAreShellQuotedAndSelectTheirTestOnly) {
     EXPECT_EQ(out, env.string());
     fs::remove_all(dir);
 }
+} // namespace test_hostile_bless

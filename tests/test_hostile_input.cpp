@@ -26,6 +26,9 @@
 namespace fs = std::filesystem;
 using namespace iblcheck;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace test_hostile_input {
+
 namespace {
 
 class HostileInput : public ::testing::Test {
@@ -265,3 +268,4 @@ TEST_F(HostileInput, NanCoverageIsBlamedOnTheShaderNotTheCost) {
     EXPECT_TRUE(std::regex_search(message, named)) << message;
     EXPECT_EQ(message.find("cost"), std::string::npos) << message;
 }
+} // namespace test_hostile_input

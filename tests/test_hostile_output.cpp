@@ -24,9 +24,10 @@ using namespace iblcheck;
 using namespace iblcheck::testutil;
 using nlohmann::json;
 
-namespace {
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace test_hostile_output {
 
-std::string bin(const std::string& name) { return std::string(IBLCHECK_BINARY_DIR) + "/" + name; }
+namespace {
 
 // A blessed one-test suite (the furnace) in a private folder, run through the CLI.
 struct Mini : FurnaceStore {
@@ -37,8 +38,8 @@ struct Mini : FurnaceStore {
         EXPECT_EQ(bless_all(), kExitPass);
     }
     int run(const std::string& args, std::string& out) const {
-        return run_command(bin("iblcheck") + " run -q --suite " + suite.string() + " --goldens " + goldens.string() + " " + args,
-                           out);
+        return run_command(
+            built("iblcheck") + " run -q --suite " + suite.string() + " --goldens " + goldens.string() + " " + args, out);
     }
 };
 
@@ -55,7 +56,7 @@ TEST(HostileOutput, CompareNeverWritesOverAnInputNorAnExistingFileWithoutForce) 
     const fs::path ref = dir / "ref.exr", test = dir / "test.exr", map = dir / "map.png";
     fs::copy(fs::path(IBLCHECK_SOURCE_DIR) / "goldens/reference/furnace__constant-1.exr", ref);
     fs::copy(ref, test);
-    const std::string before = bytes(ref), cmp = bin("iblcheck") + " compare " + ref.string() + " " + test.string();
+    const std::string before = bytes(ref), cmp = built("iblcheck") + " compare " + ref.string() + " " + test.string();
     std::string out;
     for (const std::string force : {"", " --force"}) {
         EXPECT_EQ(run_command(cmp + " --heatmap " + ref.string() + force, out), 2) << out;
@@ -78,13 +79,13 @@ TEST(HostileOutput, RenderTruthRunAndReportRefuseToOverwrite) {
     const fs::path mine = m.dir / "mine.json";
     write_file(mine, "mine");
     // render --json (it used to be written over without --force), truth over its own --env file.
-    EXPECT_EQ(run_command(bin("iblcheck") + " render --scene sphere --json " + mine.string(), out), 2) << out;
+    EXPECT_EQ(run_command(built("iblcheck") + " render --scene sphere --json " + mine.string(), out), 2) << out;
     EXPECT_NE(out.find("--json " + mine.string() + ": exists"), std::string::npos) << out;
     const fs::path env = m.dir / "env.exr";
     fs::copy(m.goldens / "reference/furnace__constant-1.exr", env);
-    EXPECT_EQ(
-        run_command(bin("iblcheck") + " truth --scene sphere --env " + env.string() + " --out " + env.string() + " --force", out),
-        2)
+    EXPECT_EQ(run_command(
+                  built("iblcheck") + " truth --scene sphere --env " + env.string() + " --out " + env.string() + " --force", out),
+              2)
         << out;
     EXPECT_NE(out.find("is also an input"), std::string::npos) << out;
     // run --junit and --json; report --out into a folder that holds files.
@@ -92,8 +93,8 @@ TEST(HostileOutput, RenderTruthRunAndReportRefuseToOverwrite) {
     EXPECT_EQ(m.run("--json " + mine.string(), out), 2) << out;
     EXPECT_EQ(bytes(mine), "mine");
     ASSERT_EQ(m.run("--out " + (m.dir / "run").string(), out), 0) << out;
-    EXPECT_EQ(run_command(bin("iblcheck") + " report " + (m.dir / "run/results.json").string() + " --out " + m.dir.string(), out),
-              2)
+    EXPECT_EQ(
+        run_command(built("iblcheck") + " report " + (m.dir / "run/results.json").string() + " --out " + m.dir.string(), out), 2)
         << out;
     EXPECT_NE(out.find("holds files"), std::string::npos) << out;
 }
@@ -120,7 +121,7 @@ TEST(HostileOutput, OutputsReplaceTheOldFileWholeNeverInPlace) {
     const fs::path render = dir / "render.json";
     const fs::path render_reader = old_file_with_reader(render);
     std::string out;
-    ASSERT_EQ(run_command(bin("iblcheck") + " render --scene sphere --env constant:1 --size 16x16 --json " + render.string() +
+    ASSERT_EQ(run_command(built("iblcheck") + " render --scene sphere --env constant:1 --size 16x16 --json " + render.string() +
                               " --force",
                           out),
               0)
@@ -201,7 +202,7 @@ TEST(HostileOutput, ReportReadsOnlyFilesInsideItsRunFolder) {
         {"test", "../../../../../../../../etc/hostname"}, {"golden", "link.png"}, {"heatmap", secret.string()}};
     write_file(m.dir / "run/results.json", r.dump());
     ASSERT_EQ(
-        run_command(bin("iblcheck") + " report " + (m.dir / "run/results.json").string() + " --out " + (m.dir / "rep").string(),
+        run_command(built("iblcheck") + " report " + (m.dir / "run/results.json").string() + " --out " + (m.dir / "rep").string(),
                     out),
         0)
         << out;
@@ -247,3 +248,4 @@ TEST(HostileOutput, AFullDiskAsOutIsExitTwoNamingThePath) {
     EXPECT_EQ(out.find("terminate called"), std::string::npos) << out;
     EXPECT_NE(out.find((full / "out").string()), std::string::npos) << out;
 }
+} // namespace test_hostile_output

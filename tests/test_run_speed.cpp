@@ -39,6 +39,9 @@ using namespace iblcheck;
 using namespace iblcheck::testutil;
 using nlohmann::json;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace test_run_speed {
+
 namespace {
 
 // Work the compiler cannot drop, so a stage has a duration above zero.
@@ -730,3 +733,4 @@ TEST(BisectStep, VersionReadsTheCommitBesideTheBinary) {
     EXPECT_NE(out.find("(commit 0123456789ab-dirty,"), std::string::npos) << out;
     fs::remove_all(dir);
 }
+} // namespace test_run_speed

@@ -22,9 +22,11 @@ namespace fs = std::filesystem;
 using namespace iblcheck;
 using namespace iblcheck::testutil;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace test_shader_contract {
+
 namespace {
 
-std::string bin() { return std::string(IBLCHECK_BINARY_DIR) + "/iblcheck"; }
 const fs::path kExample = fs::path(IBLCHECK_SOURCE_DIR) / "examples/filament_ibl/filament_ibl.glsl";
 
 const char* kShade = "vec3 ibl_shade(IblSurface s, IblInputs ibl) { return s.base_color; }\n";
@@ -134,7 +136,7 @@ TEST(ShaderContract, TextureSamplesCountEveryCallSiteOfIblShade) {
 
 TEST(Cli, ContractShaderErrorsAreExit2NamingTheFile) {
     const fs::path dir = temp_dir("contract_cli_errors");
-    const std::string render = "IBLCHECK_CACHE_DIR=" + dir.string() + " " + bin() +
+    const std::string render = "IBLCHECK_CACHE_DIR=" + dir.string() + " " + built("iblcheck") +
                                " render --scene furnace --env constant:1 --set cube_size=16 --shader ";
     std::string out;
     EXPECT_EQ(run_command(render + (dir / "missing.glsl").string(), out), 2) << out;
@@ -168,7 +170,8 @@ TEST(Cli, ContractShaderBugFailsTheRun) {
         s["tests"] = tests;
         for (auto& t : s["tests"]) t["shader"] = (dir / folder / "filament_ibl.glsl").string();
         write_file(dir / folder / "ci_example.json", s.dump());
-        return "IBLCHECK_CACHE_DIR=" + dir.string() + " " + bin() + " run --suite " + (dir / folder / "ci_example.json").string();
+        return "IBLCHECK_CACHE_DIR=" + dir.string() + " " + built("iblcheck") + " run --suite " +
+               (dir / folder / "ci_example.json").string();
     };
     std::string text = read_text(kExample), out;
     EXPECT_EQ(run_command(suite_for("same", text), out), 0) << out; // the copy itself passes
@@ -191,3 +194,4 @@ TEST(Cli, ContractShaderBugFailsTheRun) {
     EXPECT_NE(out.find("cost: cost.texture_fetches_per_pixel"), std::string::npos) << out;
     EXPECT_NE(out.find("+150.0 %"), std::string::npos) << out; // 2 fetches a shading (cube + LUT) -> 5
 }
+} // namespace test_shader_contract

@@ -22,6 +22,9 @@ using namespace iblcheck;
 using namespace iblcheck::testutil;
 using nlohmann::json;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace test_silent_passes {
+
 namespace {
 
 // The message load_suite gives for `text`, or "(loaded)".
@@ -246,3 +249,4 @@ TEST(SilentPasses, AGoldenWithAHugeFinitePixelPassesABitIdenticalRender) {
     EXPECT_EQ(other.verdict, Verdict::fail) << other.metrics.dump();
     EXPECT_GT(other.metrics["flip"]["max"].get<double>(), 0.5);
 }
+} // namespace test_silent_passes

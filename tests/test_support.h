@@ -61,6 +61,11 @@ inline std::filesystem::path temp_dir(const std::string& name) {
     return p;
 }
 
+#ifdef IBLCHECK_BINARY_DIR
+// A file of the build folder: built("iblcheck") is the CLI the tests run.
+inline std::string built(const std::string& name) { return (std::filesystem::path(IBLCHECK_BINARY_DIR) / name).string(); }
+#endif
+
 // Runs a shell command; returns its exit status (-1 if it did not exit) and its output (stdout,
 // and stderr too unless merge_stderr is false, e.g. to parse JSON from stdout).
 inline int run_command(const std::string& cmd, std::string& out, bool merge_stderr = true) {
