@@ -15,6 +15,9 @@
 
 using namespace iblcheck;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace test_astc_storage {
+
 namespace {
 
 // A smooth HDR field over a w×h image: a broad lobe of ~200 over a 0.05..2 gradient, the kind of
@@ -174,3 +177,4 @@ TEST(AstcStorage, HalfBitsDecode) {
     EXPECT_EQ(half_bits_to_float(0x7bff), 65504.0f);
     EXPECT_EQ(half_bits_to_float(0x0001), std::ldexp(1.0f, -24)); // smallest subnormal
 }
+} // namespace test_astc_storage

@@ -16,6 +16,9 @@
 namespace fs = std::filesystem;
 using namespace iblcheck;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace test_cli_startup {
+
 namespace {
 
 const std::string kCli = std::string(IBLCHECK_BINARY_DIR) + "/iblcheck";
@@ -136,3 +139,4 @@ TEST_F(CliStartup, ComparePairsFromStdinAndFromAFile) {
 }
 
 } // namespace
+} // namespace test_cli_startup

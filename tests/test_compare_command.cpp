@@ -26,6 +26,9 @@ namespace fs = std::filesystem;
 using namespace iblcheck;
 using iblcheck::testing_support::synthetic;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace test_compare_command {
+
 namespace {
 
 class CompareCommand : public ::testing::Test {
@@ -398,3 +401,4 @@ TEST_F(CompareCommand, ImagesUnderSsimsWindowGetFlipAndPsnrAndSsimNotApplicable)
     ASSERT_EQ(run(c), 0) << err_.str();
     EXPECT_NE(out_.str().find("SSIM not applicable"), std::string::npos) << out_.str();
 }
+} // namespace test_compare_command

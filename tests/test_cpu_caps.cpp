@@ -15,6 +15,9 @@
 
 using namespace iblcheck;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace test_cpu_caps {
+
 namespace {
 
 using namespace iblcheck::testutil;
@@ -151,3 +154,4 @@ TEST(CpuCaps, AgreesWithMesasOwnDumpOnThisMachine) {
         EXPECT_NE(out.find("llvmpipe cpu:    " + model.cpu_class() + " "), std::string::npos) << out;
     }
 }
+} // namespace test_cpu_caps

@@ -14,6 +14,9 @@
 
 using namespace iblcheck;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace test_env_layout {
+
 namespace {
 constexpr double kPi = 3.14159265358979323846;
 // Angle between unit vectors, accurate near 0 too (2·asin of half the chord).
@@ -198,3 +201,4 @@ TEST(MipChain, LengthFollowsTheBaseSizeAndMustReachRoughnessOne) {
     EXPECT_THROW(chain_levels("ue4", EnvLayout::cube, 128, 9), UsageError);    // more than the cube holds
     EXPECT_THROW(chain_levels("bogus", EnvLayout::cube, 128, 0), UsageError);
 }
+} // namespace test_env_layout

@@ -11,6 +11,9 @@
 using nlohmann::json;
 using namespace iblcheck::report;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace test_failure_groups {
+
 namespace {
 
 // `--filter`'s semantics: the harness's own (suite.h glob_match).
@@ -107,3 +110,4 @@ TEST(FailureGroups, DifferentChecksOrShaderChangesAreDifferentGroups) {
     EXPECT_FALSE(ran_whole_suite({{"command", "iblcheck run --suite ci --filter '*lagarde*'"}}));
     EXPECT_FALSE(ran_whole_suite({{"command", "iblcheck run --suite ci --shard 1/3"}}));
 }
+} // namespace test_failure_groups

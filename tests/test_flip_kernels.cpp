@@ -19,6 +19,9 @@
 
 using namespace iblcheck;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace test_flip_kernels {
+
 namespace {
 
 bool same_bits(const float* a, const float* b, size_t n) { return std::memcmp(a, b, n * sizeof(float)) == 0; }
@@ -203,3 +206,4 @@ TEST(Pooling, OnePassPercentilesEqualOneScanEach) {
 }
 
 } // namespace
+} // namespace test_flip_kernels

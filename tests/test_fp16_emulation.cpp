@@ -24,6 +24,9 @@
 namespace fs = std::filesystem;
 using namespace iblcheck;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace test_fp16_emulation {
+
 namespace {
 
 using namespace iblcheck::testutil;
@@ -294,3 +297,4 @@ TEST(Fp16EmulationDispatch, SameResultsOnACpuWithoutF16c) {
     EXPECT_EQ(rc, 0) << out;
     EXPECT_NE(out.find("[  PASSED  ] 2 tests"), std::string::npos) << out;
 }
+} // namespace test_fp16_emulation

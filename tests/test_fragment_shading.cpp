@@ -21,6 +21,9 @@
 using namespace iblcheck;
 using namespace iblcheck::testutil;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace test_fragment_shading {
+
 namespace {
 
 TestSpec with(TestSpec s, const std::string& key, const std::string& value) {
@@ -215,3 +218,4 @@ TEST(FragmentShading, CostIsCountedDeterministicallyAndScalesWithFragments) {
     EXPECT_NEAR(s2.shader_instructions_per_pixel / a.shader_instructions_per_pixel, 4.0, 0.4);
     expect_no_validation_errors();
 }
+} // namespace test_fragment_shading

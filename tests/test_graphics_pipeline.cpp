@@ -17,6 +17,9 @@
 namespace fs = std::filesystem;
 using namespace iblcheck;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace test_graphics_pipeline {
+
 namespace {
 
 fs::path temp_dir() {
@@ -217,3 +220,4 @@ void main() {
     EXPECT_GT(r[0].second, 1.0) << "ms";
     expect_no_validation_errors();
 }
+} // namespace test_graphics_pipeline

@@ -20,6 +20,9 @@
 namespace fs = std::filesystem;
 using namespace iblcheck;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace test_image_formats {
+
 namespace {
 
 class ImageFormats : public ::testing::Test {
@@ -291,3 +294,4 @@ TEST_F(ImageFormats, BadFilesNameThePathAndTheProblem) {
     }
     EXPECT_EQ(message(path("none.png")), path("none.png") + ": file not found");
 }
+} // namespace test_image_formats

@@ -11,6 +11,9 @@ using nlohmann::json;
 
 using testutil::input_error_of;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace test_json_check {
+
 TEST(JsonChecker, FailNamesFileWhereAndProblem) {
     const JsonChecker c("suites/x.json");
     EXPECT_EQ(input_error_of([&] { c.fail("tests[2].size", "'big' is not WxH"); }),
@@ -55,3 +58,4 @@ TEST(JsonChecker, MembersAreOptionalUnlessRequiredAndTyped) {
     EXPECT_EQ(input_error_of([&] { c.member(obj, "t", "list", JsonType::object); }),
               "r.json: t: 'list' must be an object, not array");
 }
+} // namespace test_json_check

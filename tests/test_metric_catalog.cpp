@@ -14,6 +14,9 @@
 using namespace iblcheck;
 using iblcheck::testing_support::synthetic;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace test_metric_catalog {
+
 namespace {
 
 // A display test's comparison of two different HDR images, with `compare`'s linear PSNR too: every
@@ -76,3 +79,4 @@ TEST(MetricCatalog, SummaryNamesAreUniqueAndFloorsStartAtZero) {
     EXPECT_EQ(floor_distance(metric("ssim.mean"), 1.0), 0.0);
     EXPECT_EQ(floor_distance(metric("display_ssim.mean"), 0.75), 0.25);
 }
+} // namespace test_metric_catalog

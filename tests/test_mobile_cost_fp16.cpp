@@ -25,6 +25,9 @@
 using namespace iblcheck;
 using namespace iblcheck::testutil;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace test_mobile_cost_fp16 {
+
 namespace {
 
 // How far two renders of the same scene are apart: HDR-FLIP (mean, max), the largest channel
@@ -308,3 +311,4 @@ TEST(MobileCost, EmulatedFp16CountsTheShaderAsWrittenLikeNative) {
     EXPECT_GT(native, 1000.0);
     EXPECT_EQ(emulated, native);
 }
+} // namespace test_mobile_cost_fp16

@@ -28,6 +28,9 @@
 using namespace iblcheck;
 using namespace iblcheck::testutil;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace test_mobile_pipeline {
+
 namespace {
 
 // EnvBRDFApprox (Karis 2014), as env_brdf.glsl, evaluated on the CPU.
@@ -242,3 +245,4 @@ TEST(MobileOptions, UnknownOptionAndValueAreUsageErrors) {
     EXPECT_THROW(render(spec("sphere", "studio", {{"mip_mapping", "bogus"}})), UsageError);
     EXPECT_THROW(render(spec("sphere", "studio", {{"cube_size", "100"}})), UsageError);
 }
+} // namespace test_mobile_pipeline

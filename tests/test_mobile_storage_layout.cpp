@@ -25,6 +25,9 @@
 using namespace iblcheck;
 using namespace iblcheck::testutil;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace test_mobile_storage_layout {
+
 namespace {
 
 using Opts = std::vector<std::pair<std::string, std::string>>;
@@ -320,3 +323,4 @@ TEST(StorageLayout, AoIsRefusedByMethodsThatDoNotModelIt) {
     s.method = "sampled";
     EXPECT_THROW(validate_spec(s), UsageError);
 }
+} // namespace test_mobile_storage_layout

@@ -17,6 +17,9 @@
 namespace fs = std::filesystem;
 using namespace iblcheck;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace test_option_defaults {
+
 namespace {
 // One read of an option in the product code: where, how (the accessor) and the key.
 struct Read {
@@ -198,3 +201,4 @@ TEST(OptionDefaults, ListShowsEveryDefault) {
         EXPECT_NE(line.find("default " + o.default_text()), std::string::npos) << line;
     }
 }
+} // namespace test_option_defaults

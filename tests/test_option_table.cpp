@@ -16,6 +16,9 @@
 namespace fs = std::filesystem;
 using namespace iblcheck;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace test_option_table {
+
 namespace {
 std::string shader_sources() {
     std::string all;
@@ -162,3 +165,4 @@ TEST(OptionTable, EachShadingPathRefusesTheOthersDefine) {
     EXPECT_THROW(vk::compile_shader("shade_spheres.frag", comp_defs), ShaderCompileError);
     EXPECT_THROW(vk::compile_shader("shade_spheres.vert", comp_defs), ShaderCompileError);
 }
+} // namespace test_option_table

@@ -21,6 +21,9 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 using namespace iblcheck;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace test_own_environment {
+
 namespace {
 
 const std::string kCli = std::string(IBLCHECK_BINARY_DIR) + "/iblcheck";
@@ -159,3 +162,4 @@ TEST_F(OwnEnvironment, ASuiteNamesAnEnvironmentFileAndRefusesABuiltInName) {
 }
 
 } // namespace
+} // namespace test_own_environment

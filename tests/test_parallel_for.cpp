@@ -11,6 +11,9 @@
 
 using namespace iblcheck;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace test_parallel_for {
+
 TEST(ParallelFor, EveryIndexExactlyOnceForAnyThreadCount) {
     for (int n : {0, 1, 7, 100})
         for (int threads : {1, 2, 3, 8, 0}) {
@@ -87,3 +90,4 @@ TEST(ParallelFor, AThrowingBodyIsRethrownInTheCaller) {
                      8, 3, []() -> int { throw std::runtime_error("no device"); }, [](int, int&) {}),
                  std::runtime_error);
 }
+} // namespace test_parallel_for

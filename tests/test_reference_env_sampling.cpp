@@ -11,6 +11,9 @@
 
 using namespace iblcheck;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace test_reference_env_sampling {
+
 namespace {
 constexpr double kPi = 3.14159265358979323846;
 
@@ -136,3 +139,4 @@ TEST(ReferenceIntegrator, WindowedEnvSamplingIsUnbiasedAndLessNoisy) {
     std::printf("diffuse sphere/studio 64x64, 128 spp: relative RMSE between seeds, global %.4f, window %.4f\n", ng.relative_rmse,
                 nw.relative_rmse);
 }
+} // namespace test_reference_env_sampling

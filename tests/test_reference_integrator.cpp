@@ -14,6 +14,9 @@
 
 using namespace iblcheck;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace test_reference_integrator {
+
 namespace {
 constexpr double kPi = 3.14159265358979323846;
 
@@ -428,3 +431,4 @@ TEST(ReferenceIntegrator, PixelPatternErrorIsSmall) {
                 "%.6f, mirror-sphere relative RMSE %.5f\n",
                 int(edge), sum_d / edge, cov_c / cov_a, rel);
 }
+} // namespace test_reference_integrator

@@ -21,6 +21,9 @@ using nlohmann::json;
 using namespace iblcheck;
 using testutil::kEvilName;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace test_report {
+
 namespace {
 
 std::string slurp(const fs::path& p) {
@@ -294,3 +297,4 @@ TEST(Report, ResultsWithoutEXRsShowThePNGs) {
     EXPECT_NE(fail.find("worst 16&times;16 block at (96,16)"), std::string::npos);
     EXPECT_FALSE(fs::exists(out / "data"));
 }
+} // namespace test_report

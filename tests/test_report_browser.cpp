@@ -23,6 +23,9 @@ using nlohmann::json;
 using namespace iblcheck;
 using testutil::Browser;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace test_report_browser {
+
 namespace {
 
 const char* kReady = "document.body && document.body.getAttribute('data-check') === 'done'";
@@ -351,3 +354,4 @@ TEST(ReportBrowser, FalseColourAndExposurePerSphereShowWhatOneExposureBlowsOut) 
     }
     fs::remove_all(dir);
 }
+} // namespace test_report_browser

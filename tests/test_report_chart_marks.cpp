@@ -9,6 +9,9 @@
 
 using namespace iblcheck::report;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace test_report_chart_marks {
+
 TEST(ReportChartMarks, TwentySixFamiliesHaveTwentySixGlyphs) {
     const auto& shapes = marker_shapes();
     std::set<std::string> distinct(shapes.begin(), shapes.end());
@@ -52,3 +55,4 @@ TEST(ReportChartMarks, XTickLabelsAreShortAndDoNotTouchAndFailuresAreRinged) {
         ++rings;
     EXPECT_EQ(rings, 1u);
 }
+} // namespace test_report_chart_marks

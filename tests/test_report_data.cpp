@@ -27,6 +27,9 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 using namespace iblcheck;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace test_report_data {
+
 TEST(Report, MalformedResultsNameFileAndProblem) {
     auto& f = testutil::small_run();
     auto expect_error = [&](json r, const std::string& what) {
@@ -274,3 +277,4 @@ TEST(VerdictText, FailureSaysWhatWhereHowMuchAndHowToApprove) {
               "'mobile.roughness_sweep.studio.dominant_dir=lagarde|mobile.furnace.constant'");
     EXPECT_EQ(report::rebless_all_line(json::array({f.results["tests"][0]}), "ci"), "");
 }
+} // namespace test_report_data

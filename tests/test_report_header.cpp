@@ -14,6 +14,9 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 using namespace iblcheck;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace test_report_header {
+
 namespace {
 
 std::string header_of(const fs::path& index) {
@@ -79,3 +82,4 @@ TEST(ReportAssets, PageCarriesTheAssetFilesByteForByte) {
     EXPECT_EQ(html.substr(html.size() - tail.size()), tail);
     fs::remove_all(dir);
 }
+} // namespace test_report_header

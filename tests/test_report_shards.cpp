@@ -17,6 +17,9 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 using namespace iblcheck;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace test_report_shards {
+
 namespace {
 
 const std::string kCli = std::string(IBLCHECK_BINARY_DIR) + "/iblcheck";
@@ -110,3 +113,4 @@ TEST_F(ReportShards, FourShardsMergeIntoTheVerdictsAndJUnitOfOneUnshardedRun) {
 }
 
 } // namespace
+} // namespace test_report_shards

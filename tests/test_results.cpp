@@ -16,6 +16,9 @@
 using namespace iblcheck;
 using nlohmann::json;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace test_results {
+
 namespace {
 
 std::set<std::string> field_keys(ResultsObject object) {
@@ -238,3 +241,4 @@ TEST(Results, TheReaderChecksEachCheckedKeyByItsFieldType) {
     }
     EXPECT_GT(checked, 40);
 }
+} // namespace test_results

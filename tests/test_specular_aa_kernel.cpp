@@ -37,6 +37,9 @@
 namespace fs = std::filesystem;
 using namespace iblcheck;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace test_specular_aa_kernel {
+
 namespace {
 
 using V3 = std::array<double, 3>;
@@ -263,3 +266,4 @@ TEST(SpecularAaKernel, BrokenKernelsMissTheAnalyticFootprint) {
             }
         }
 }
+} // namespace test_specular_aa_kernel

@@ -19,6 +19,9 @@
 namespace fs = std::filesystem;
 using namespace iblcheck;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace test_spirv_cost {
+
 namespace {
 // Compile options that instrument the shader (spirv_cost.h).
 const vk::CompileOptions kCounted = [] {
@@ -322,3 +325,4 @@ void main() { d.v[0] = 1.0; }
     EXPECT_THROW(vk::instrument_instruction_count(s.spirv), ShaderCompileError);
     EXPECT_THROW(vk::instrument_instruction_count({1, 2, 3}), Error);
 }
+} // namespace test_spirv_cost

@@ -21,6 +21,9 @@ using namespace iblcheck::testutil;
 namespace fs = std::filesystem;
 using std::chrono::hours;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace test_store_budget {
+
 namespace {
 
 const fs::file_time_type kNow = fs::file_time_type::clock::now();
@@ -181,3 +184,4 @@ TEST(StoreBudget, BudgetComesFromTheEnvironmentAndABadValueIsNamed) {
         }
     }
 }
+} // namespace test_store_budget

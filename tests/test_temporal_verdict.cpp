@@ -8,6 +8,9 @@
 using nlohmann::json;
 using namespace iblcheck::report;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace test_temporal_verdict {
+
 namespace {
 
 // A temporal test of `scene` with specular_aa = aa, its truth figures and off's.
@@ -77,3 +80,4 @@ TEST(TemporalVerdict, HtmlHasTheParagraphAndOnePanelPerSceneWithOffAtTheOrigin) 
     EXPECT_NE(h.find("data-chart=\"aa-verdict-bumpy-sphere-sky-sun\" data-points=\"3\""), std::string::npos);
     EXPECT_EQ(aa_verdict_html({}), ""); // no temporal truth figures: no section
 }
+} // namespace test_temporal_verdict

@@ -15,6 +15,9 @@
 namespace fs = std::filesystem;
 using namespace iblcheck;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace test_truth_command {
+
 namespace {
 
 const std::string kCli = std::string(IBLCHECK_BINARY_DIR) + "/iblcheck";
@@ -118,3 +121,4 @@ TEST_F(TruthCommand, PrintNameIsTheGoldenStoresKeyAndWritesNothing) {
 }
 
 } // namespace
+} // namespace test_truth_command

@@ -14,6 +14,9 @@ using namespace iblcheck;
 using namespace iblcheck::truth;
 namespace fs = std::filesystem;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace test_truth_golden {
+
 namespace {
 TestSpec spec_of(const std::string& scene, const std::string& env, int w = 0, int h = 0) {
     TestSpec s;
@@ -96,3 +99,4 @@ TEST(TruthRenderer, CommittedReferenceGoldensStateABoundThatHolds) {
     EXPECT_EQ(monte_carlo, 1);
     EXPECT_EQ(sequences, 3);
 }
+} // namespace test_truth_golden

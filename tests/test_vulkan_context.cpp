@@ -20,6 +20,9 @@
 namespace fs = std::filesystem;
 using namespace iblcheck;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace test_vulkan_context {
+
 namespace {
 
 using namespace iblcheck::testutil;
@@ -278,3 +281,4 @@ TEST(Cli, ShaderCompileErrorExitsTwoWithFileLine) {
     EXPECT_NE(out.find("env_brdf.glsl:"), std::string::npos) << out;
     fs::remove_all(dir);
 }
+} // namespace test_vulkan_context

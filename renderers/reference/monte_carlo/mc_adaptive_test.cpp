@@ -7,6 +7,9 @@
 
 using namespace iblcheck::reference;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace mc_adaptive_test {
+
 // 5x1 pixels: counts ∝ the 3x3 maximum of r relative to its mean, clamped to [M̄/4, cap·M̄]; pixels
 // nothing can hit (r < 0) keep M̄; silhouette pixels get at least boost·M̄.
 TEST(McAdaptive, CountsFollowTheNeighbourhoodMaximumWithinTheLimits) {
@@ -36,3 +39,4 @@ TEST(McAdaptive, UniformNoiseGivesTheMeanCount) {
                                                AdaptiveLimits{4, 16, 16});
     for (int v : z) EXPECT_EQ(v, 4);
 }
+} // namespace mc_adaptive_test

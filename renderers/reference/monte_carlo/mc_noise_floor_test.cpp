@@ -8,6 +8,9 @@
 
 using namespace iblcheck;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace mc_noise_floor_test {
+
 TEST(McNoiseFloor, RelativeRmseOverCoveredPixels) {
     cv::Mat a(1, 3, CV_32FC3, cv::Scalar(1, 1, 1)), b(1, 3, CV_32FC3, cv::Scalar(1, 1, 1));
     b.at<cv::Vec3f>(0, 0) = cv::Vec3f(1.1f, 1.1f, 1.1f);
@@ -26,3 +29,4 @@ TEST(McNoiseFloor, RelativeRmseOverCoveredPixels) {
     const double dz = double(0.1f), mz = 0.5 * dz;
     EXPECT_NEAR(relative_rmse(z, w, cv::Mat(1, 1, CV_32FC1, cv::Scalar(1))), dz / std::sqrt(mz * mz + 0.01), 1e-12);
 }
+} // namespace mc_noise_floor_test

@@ -10,6 +10,9 @@
 using namespace iblcheck;
 using namespace iblcheck::reference;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace mc_pixel_test {
+
 // Every sub-pixel ray of the roughness sweep (4x4 per pixel) that hits a sphere hits one of the pixel's
 // candidates, and intersect_candidates finds the same sphere and normal as intersect().
 TEST(McPixel, CandidatesAreConservativeAndIntersectAsTheScene) {
@@ -72,3 +75,4 @@ TEST(McPixel, CoverageIsTheFractionOfPositionsThatHit) {
         break;
     }
 }
+} // namespace mc_pixel_test

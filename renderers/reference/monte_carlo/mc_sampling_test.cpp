@@ -10,6 +10,9 @@
 using namespace iblcheck;
 using namespace iblcheck::reference;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace mc_sampling_test {
+
 namespace {
 constexpr double kPi = model::kPi;
 
@@ -109,3 +112,4 @@ TEST(McSampling, MisWeightsOfTheTwoStrategiesSumToOne) {
     EXPECT_DOUBLE_EQ(mis_weight_brdf_sample(1, 2, true), 0.2); // 1/(1+4)
     EXPECT_DOUBLE_EQ(mis_weight_brdf_sample(1, 3, false), 0.25);
 }
+} // namespace mc_sampling_test

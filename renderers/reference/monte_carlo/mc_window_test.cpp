@@ -10,6 +10,9 @@
 using namespace iblcheck;
 using namespace iblcheck::reference;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace mc_window_test {
+
 namespace {
 struct Fixture {
     Scene scene = build_scene("sphere", OptionMap{});
@@ -64,3 +67,4 @@ TEST(McWindow, WindowPdfIsNormalisedAndMatchesItsSamples) {
             }
         }
 }
+} // namespace mc_window_test

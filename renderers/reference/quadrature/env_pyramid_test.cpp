@@ -9,6 +9,9 @@
 using namespace iblcheck;
 using namespace iblcheck::truth;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace env_pyramid_test {
+
 namespace {
 Environment random_env(int W, int H, unsigned seed) {
     Environment e;
@@ -232,3 +235,4 @@ TEST(EnvPyramid, ChannelWeightsReproduceEachChannelsMeanDirection) {
     EXPECT_LT(worst_new, 1e-4);
     EXPECT_GT(worst_old, 0.02); // the colour shift the offsets correct is real in this environment
 }
+} // namespace env_pyramid_test

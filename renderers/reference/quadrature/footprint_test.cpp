@@ -9,6 +9,9 @@
 
 using namespace iblcheck::truth;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace footprint_test {
+
 namespace {
 constexpr double kPi = 3.14159265358979323846;
 
@@ -169,3 +172,4 @@ TEST(Footprint, VariationBoundFindsASmallBrightSpot) {
     std::printf("spot pixel: exact %.4f, with the bound %.4f (%ld points), without %.4f (%ld points)\n", expect, with.rgb[0],
                 with.evaluations, without.rgb[0], without.evaluations);
 }
+} // namespace footprint_test

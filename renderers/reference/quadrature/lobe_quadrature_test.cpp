@@ -9,6 +9,9 @@
 using namespace iblcheck;
 using namespace iblcheck::truth;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace lobe_quadrature_test {
+
 namespace {
 MaterialLobe metal(double roughness, double f0 = 1.0) {
     Material m;
@@ -138,3 +141,4 @@ TEST(LobeQuadrature, IndicatorBoundsErrorAgainstFinerSolution) {
         }
     std::printf("%d shading points: largest error / indicator %.3f\n", checked, worst_ratio);
 }
+} // namespace lobe_quadrature_test

@@ -8,6 +8,9 @@
 using namespace iblcheck;
 using namespace iblcheck::truth;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace normal_table_test {
+
 namespace {
 MaterialLobe lobe_of(double roughness, double metallic) {
     Material m;
@@ -127,3 +130,4 @@ TEST(NormalTable, EdgeNodesAreShadedOnceWhateverTheThreads) {
         for (int c = 0; c < 3; ++c) EXPECT_EQ(a[c], b[c]);
     }
 }
+} // namespace normal_table_test

@@ -13,6 +13,9 @@
 using namespace iblcheck;
 using namespace iblcheck::truth;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace split_sum_test {
+
 namespace {
 
 // ∫ D(h)(n·l)⁺ dl at n = v, independently of the closed form's change of variables: a midpoint rule
@@ -153,3 +156,4 @@ TEST(SplitSum, PrefilteredRadianceOfASmallPatchMatchesBruteForce) {
         EXPECT_GT(std::fabs(expected / brute_truth - 1), 0.01) << "the split sum is an approximation here";
     }
 }
+} // namespace split_sum_test

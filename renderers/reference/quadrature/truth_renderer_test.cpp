@@ -18,6 +18,9 @@
 using namespace iblcheck;
 using namespace iblcheck::truth;
 
+// Its own namespace: the test programs of one group compile as unity batches (tests/CMakeLists.txt).
+namespace truth_renderer_test {
+
 namespace {
 TestSpec spec_of(const std::string& scene, const std::string& env, int w = 0, int h = 0) {
     TestSpec s;
@@ -246,3 +249,4 @@ TEST(TruthRenderer, MirrorPixelsSumToTheEnvironmentIntegralWithinTheDepthCap) {
                 per_pixel, sum[1] / (r2 / 4 * env_integral[1]));
     EXPECT_LT(per_pixel, 2 * std::pow(4.0, acc.bound_depth)); // measured 7375 (66006 without the cap)
 }
+} // namespace truth_renderer_test
