@@ -21,7 +21,7 @@ namespace test_cli_startup {
 
 namespace {
 
-const std::string kCli = std::string(IBLCHECK_BINARY_DIR) + "/iblcheck";
+const std::string kCli = testutil::built("iblcheck");
 
 // The shared objects the dynamic linker opened for `iblcheck ARGS` (LD_DEBUG=files: "file=NAME [0];
 // needed by ..." or "... dynamically loaded by ...").

@@ -117,7 +117,7 @@ TEST(CpuCaps, AgreesWithMesasOwnDumpOnThisMachine) {
     std::ifstream f("/proc/cpuinfo");
     std::stringstream cpuinfo;
     cpuinfo << f.rdbuf();
-    std::string bin = std::string(IBLCHECK_BINARY_DIR) + "/iblcheck doctor";
+    std::string bin = built("iblcheck") + " doctor";
     struct Run {
         const char* override_caps;
         const char* width;

@@ -213,10 +213,7 @@ TEST(DisplaySuite, BadDisplayConfigNamesTheFileAndTheField) {
     }
     std::string out;
     const fs::path f = dir / "bad0.json";
-    EXPECT_EQ(run_command(std::string(IBLCHECK_BINARY_DIR) + "/iblcheck run -q --suite " + f.string() + " --out " +
-                              (dir / "out").string(),
-                          out),
-              2)
+    EXPECT_EQ(run_command(built("iblcheck") + " run -q --suite " + f.string() + " --out " + (dir / "out").string(), out), 2)
         << out;
     EXPECT_NE(out.find(f.string() + ": tests[0].display.tonemap: unknown tonemapper 'aces_fitted'"), std::string::npos) << out;
 }

@@ -137,7 +137,7 @@ TEST(ExploreCli, TinySpaceGivesTheSameFrontOnARerunAndWritesTheWinnersSuite) {
     EXPECT_EQ(suite["tests"][0]["env"], "studio");
     // An existing output is not overwritten unasked; a bad axis is exit 2 naming it.
     EXPECT_EQ(testutil::run_command(cmd + (dir / "a.json").string(), out), 2) << out;
-    EXPECT_EQ(testutil::run_command(std::string(IBLCHECK_BINARY_DIR) + "/iblcheck explore --axis 'diffuse=sh9|cube'", out), 2);
+    EXPECT_EQ(testutil::run_command(testutil::built("iblcheck") + " explore --axis 'diffuse=sh9|cube'", out), 2);
     EXPECT_NE(out.find("unknown value 'cube'"), std::string::npos) << out;
 }
 

@@ -187,7 +187,7 @@ TEST_F(HostileInput, FifosAreRefusedByEveryReader) {
 TEST_F(HostileInput, CliRefusesFifos) {
     const std::string fifo = path("cli_fifo");
     ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
-    const std::string cli = "timeout 30 " + std::string(IBLCHECK_BINARY_DIR) + "/iblcheck ";
+    const std::string cli = "timeout 30 " + testutil::built("iblcheck") + " ";
     std::string out;
     EXPECT_EQ(testutil::run_command(cli + "compare --pairs " + fifo, out), 2);
     EXPECT_EQ(out, "error: " + fifo + ": is a FIFO (named pipe), not a regular file\n");

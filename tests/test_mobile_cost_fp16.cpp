@@ -265,7 +265,7 @@ TEST(MobileFp16, RendersWithoutShaderFloat16InAChildProcess) {
     namespace fs = std::filesystem;
     fs::path dir = fs::temp_directory_path() / ("iblcheck_fp16_child_" + std::to_string(::getpid()));
     fs::create_directories(dir);
-    std::string bin = std::string(IBLCHECK_BINARY_DIR) + "/iblcheck";
+    std::string bin = built("iblcheck");
     std::string exr = (dir / "sse41.exr").string(), err = (dir / "stderr.txt").string(), out;
     int rc = run_command("GALLIUM_OVERRIDE_CPU_CAPS=sse4.1 " + bin +
                              " render --scene roughness_sweep --method mobile --env sky_sun --set precision=mediump"

@@ -296,9 +296,8 @@ TEST(StorageLayout, AstcRendersDoNotDependOnWhatTheProcessEncodedFirst) {
                                                     "reference": false, "variants": )") +
                                            orders[k] + "}]}");
         std::string out;
-        ASSERT_EQ(run_command(std::string(IBLCHECK_BINARY_DIR) + "/iblcheck bless --suite " +
-                                  (dir / ("order" + std::to_string(k) + ".json")).string() + " --goldens " +
-                                  (dir / ("goldens" + std::to_string(k))).string(),
+        ASSERT_EQ(run_command(built("iblcheck") + " bless --suite " + (dir / ("order" + std::to_string(k) + ".json")).string() +
+                                  " --goldens " + (dir / ("goldens" + std::to_string(k))).string(),
                               out),
                   0)
             << out;

@@ -175,8 +175,7 @@ TEST(NightlyFindings, ReportFindingsFlagReadsTheFileOrNamesItInAnExit2) {
     testutil::make_ci_run(dir / "run", 2, false);
     testutil::write_file(dir / "b.json", budget().dump());
     testutil::write_file(dir / "bad.json", R"({"suite": "ci"})");
-    const std::string cli =
-        std::string(IBLCHECK_BINARY_DIR) + "/iblcheck report " + (dir / "run" / "results.json").string() + " --out ";
+    const std::string cli = testutil::built("iblcheck") + " report " + (dir / "run" / "results.json").string() + " --out ";
     std::string out;
     ASSERT_EQ(testutil::run_command(cli + (dir / "ok").string() + " --findings " + (dir / "b.json").string(), out), 0) << out;
     EXPECT_NE(testutil::read_text(dir / "ok" / "index.html").find("Under studio, the largest share of error is split sum"),

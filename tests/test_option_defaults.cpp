@@ -13,6 +13,7 @@
 #include "renderers/option_table.h"
 #include "renderers/renderer.h"
 #include "renderers/scenes/scene.h"
+#include "tests/test_support.h"
 
 namespace fs = std::filesystem;
 using namespace iblcheck;
@@ -184,7 +185,7 @@ TEST(OptionDefaults, ListShowsEveryDefault) {
     EXPECT_EQ(option_info("mix_largest_weight").default_text(), "10000");
     EXPECT_EQ(option_info("integrator").default_text(), "quadrature (spp set: monte_carlo)");
     EXPECT_EQ(option_info("base_color").default_text(), "1,1,1 (bumpy_sphere: 0.95,0.93,0.88; sphere_field: 0.95,0.93,0.88)");
-    FILE* p = popen((std::string(IBLCHECK_BINARY_DIR) + "/iblcheck list 2>&1").c_str(), "r");
+    FILE* p = popen((testutil::built("iblcheck") + " list 2>&1").c_str(), "r");
     ASSERT_NE(p, nullptr);
     std::string out;
     char buf[4096];

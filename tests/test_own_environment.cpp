@@ -26,7 +26,7 @@ namespace test_own_environment {
 
 namespace {
 
-const std::string kCli = std::string(IBLCHECK_BINARY_DIR) + "/iblcheck";
+const std::string kCli = testutil::built("iblcheck");
 
 // A small 2:1 panorama: a sky gradient and one bright patch (so the sphere's shading varies).
 void write_hdri(const fs::path& file, float gain) {

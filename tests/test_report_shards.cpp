@@ -22,7 +22,7 @@ namespace test_report_shards {
 
 namespace {
 
-const std::string kCli = std::string(IBLCHECK_BINARY_DIR) + "/iblcheck";
+const std::string kCli = testutil::built("iblcheck");
 const std::vector<std::string> kTests = {"mobile.furnace.constant:1.default", "mobile.furnace.constant:1.env_brdf=lut",
                                          "mobile.furnace_dielectric.constant:1.default",
                                          "mobile.furnace.constant:1.normalization=directional"};

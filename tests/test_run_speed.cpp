@@ -103,9 +103,9 @@ TEST(Profile, RunPrintsStagesAndEachTestRecordsThem) {
     const fs::path out = store.dir / "out";
     std::string text;
     // An empty precompute store of its own, so the precompute and the ASTC encode run (and are stored).
-    const std::string cmd = "IBLCHECK_PRECOMPUTE_CACHE=" + (store.dir / "precompute").string() + " " +
-                            std::string(IBLCHECK_BINARY_DIR) + "/iblcheck run --suite " + store.suite.string() + " --goldens " +
-                            store.goldens.string() + " -q --jobs 1 --profile --out " + out.string();
+    const std::string cmd = "IBLCHECK_PRECOMPUTE_CACHE=" + (store.dir / "precompute").string() + " " + built("iblcheck") +
+                            " run --suite " + store.suite.string() + " --goldens " + store.goldens.string() +
+                            " -q --jobs 1 --profile --out " + out.string();
     ASSERT_EQ(run_command(cmd, text), 0) << text;
     for (const char* stage :
          {"profile:", "precompute", "precompute_store", "astc_encode", "spirv_compile_or_cache", "pipeline_create", "shading",

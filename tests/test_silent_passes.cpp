@@ -101,8 +101,7 @@ struct Mini : FurnaceStore {
         write_file(sidecar(), side.dump(2));
     }
     std::string cli(const std::string& args) const {
-        return std::string(IBLCHECK_BINARY_DIR) + "/iblcheck " + args + " --suite " + suite.string() + " --goldens " +
-               goldens.string();
+        return built("iblcheck") + " " + args + " --suite " + suite.string() + " --goldens " + goldens.string();
     }
 };
 
@@ -184,8 +183,8 @@ TEST(SilentPasses, BisectSaysCannotTestForAnythingButAVerdict) {
     const fs::path other = m.dir / "other_goldens"; // a golden root without this test's baseline
     fs::create_directories(other);
     fs::copy(m.goldens / "reference", other / "reference");
-    EXPECT_EQ(run_command(std::string(IBLCHECK_BINARY_DIR) + "/iblcheck bisect --filter 'mobile.*' --suite " + m.suite.string() +
-                              " --goldens " + other.string(),
+    EXPECT_EQ(run_command(built("iblcheck") + " bisect --filter 'mobile.*' --suite " + m.suite.string() + " --goldens " +
+                              other.string(),
                           out),
               kExitCannotTest)
         << out;

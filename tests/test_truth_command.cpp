@@ -20,7 +20,7 @@ namespace test_truth_command {
 
 namespace {
 
-const std::string kCli = std::string(IBLCHECK_BINARY_DIR) + "/iblcheck";
+const std::string kCli = testutil::built("iblcheck");
 
 nlohmann::json read_json(const fs::path& p) {
     std::ifstream f(p);

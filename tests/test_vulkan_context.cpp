@@ -231,7 +231,7 @@ TEST(ShaderCompiler, AllPipelineShadersCompile) {
 
 TEST(Doctor, NamesLlvmpipeAndExitsZero) {
     std::string out;
-    int rc = run_command(std::string(IBLCHECK_BINARY_DIR) + "/iblcheck doctor", out);
+    int rc = run_command(built("iblcheck") + " doctor", out);
     EXPECT_EQ(rc, 0) << out;
     EXPECT_NE(out.find("llvmpipe"), std::string::npos) << out;
     EXPECT_NE(out.find("shaderFloat16:   yes"), std::string::npos) << out;
@@ -246,12 +246,11 @@ TEST(Doctor, StatesTheFp16DecisionTheRendererMakes) {
         "precision=mediump: " +
         vk::fp16_path_description(vk::choose_fp16_path("auto", ctx.info().shader_float16, ctx.info().device_name));
     std::string out;
-    EXPECT_EQ(run_command(std::string(IBLCHECK_BINARY_DIR) + "/iblcheck doctor", out), 0) << out;
+    EXPECT_EQ(run_command(built("iblcheck") + " doctor", out), 0) << out;
     EXPECT_NE(out.find(expected + "\n"), std::string::npos) << out;
     EXPECT_NE(out.find("precision=mediump: native float16_t\n"), std::string::npos) << out;
     EXPECT_NE(out.find("llvmpipe cpu:    "), std::string::npos) << out;
-    EXPECT_EQ(run_command("GALLIUM_OVERRIDE_CPU_CAPS=sse4.1 " + std::string(IBLCHECK_BINARY_DIR) + "/iblcheck doctor", out), 0)
-        << out;
+    EXPECT_EQ(run_command("GALLIUM_OVERRIDE_CPU_CAPS=sse4.1 " + built("iblcheck") + " doctor", out), 0) << out;
     EXPECT_NE(out.find("shaderFloat16:   no\n"), std::string::npos) << out;
     EXPECT_NE(out.find("precision=mediump: " + vk::fp16_path_description(vk::Fp16Path::emulated) + "\n"), std::string::npos)
         << out;
@@ -273,10 +272,9 @@ TEST(Cli, ShaderCompileErrorExitsTwoWithFileLine) {
     fs::copy(fs::path(IBLCHECK_SOURCE_DIR) / "renderers/shaders", dir / "shaders", fs::copy_options::recursive);
     std::ofstream(dir / "shaders/env_brdf.glsl", std::ios::app) << "\nthis is not glsl;\n";
     std::string out;
-    int rc =
-        run_command("IBLCHECK_SHADER_DIR=" + (dir / "shaders").string() + " IBLCHECK_CACHE_DIR=" + dir.string() + " " +
-                        std::string(IBLCHECK_BINARY_DIR) + "/iblcheck render --scene sphere --env constant:1 --method mobile",
-                    out);
+    int rc = run_command("IBLCHECK_SHADER_DIR=" + (dir / "shaders").string() + " IBLCHECK_CACHE_DIR=" + dir.string() + " " +
+                             built("iblcheck") + " render --scene sphere --env constant:1 --method mobile",
+                         out);
     EXPECT_EQ(rc, 2) << out;
     EXPECT_NE(out.find("env_brdf.glsl:"), std::string::npos) << out;
     fs::remove_all(dir);
