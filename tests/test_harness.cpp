@@ -17,6 +17,7 @@
 #include <sys/wait.h>
 
 #include "harness/golden_store.h"
+#include "harness/metrics_store.h"
 #include "harness/run_console.h"
 #include "harness/runner.h"
 #include "harness/sphere_errors.h"
@@ -24,6 +25,8 @@
 #include "kernel/errors.h"
 #include "kernel/shell_quote.h"
 #include "renderers/environments/environment.h"
+#include "renderers/mobile/cost_store.h"
+#include "renderers/mobile/precompute_store.h"
 #include "tests/test_support.h"
 
 namespace fs = std::filesystem;
@@ -311,14 +314,14 @@ TEST(Gate, ShaderChangeFailsExactlyTheAffectedCiTestsAndBisectFollowsTheContract
     // is what it would compute. Issue 33, this test alone in a checkout whose stores hold the ci
     // suite's: 25.3 s with private stores; 15.4 s, then 7.5 s once its own counts and metrics are
     // stored too. The size budget (kernel/store_budget.h) keeps what it adds from piling up.
-    const fs::path stores = std::getenv("IBLCHECK_CACHE_DIR") ? fs::path(std::getenv("IBLCHECK_CACHE_DIR"))
-                                                              : fs::path(IBLCHECK_SOURCE_DIR) / ".cache";
+    // Each store's folder as the stores themselves find it (*_store_dir): the checkout's, unless the
+    // caller placed it.
     std::string env = "IBLCHECK_CACHE_DIR=" + dir.string() + " IBLCHECK_SHADER_DIR=" + (dir / "shaders").string() + " ";
-    for (const auto& [var, folder] : {std::pair{"IBLCHECK_PRECOMPUTE_CACHE", "precompute"},
-                                      {"IBLCHECK_COST_CACHE", "cost"},
-                                      {"IBLCHECK_METRICS_CACHE", "metrics"}}) {
+    for (const auto& [var, folder] : {std::pair{"IBLCHECK_PRECOMPUTE_CACHE", precompute_store_dir()},
+                                      {"IBLCHECK_COST_CACHE", cost_store_dir()},
+                                      {"IBLCHECK_METRICS_CACHE", metrics_store_dir()}}) {
         const char* set = std::getenv(var); // a store the caller placed or turned off stays so
-        env += std::string(var) + "=" + shell_quote(set ? std::string(set) : (stores / folder).string()) + " ";
+        env += std::string(var) + "=" + shell_quote(set ? std::string(set) : folder.string()) + " ";
     }
     std::string out;
     int rc = run_command(env + built("iblcheck") + " run --suite ci -q --json " + (dir / "bad.json").string(), out);
