@@ -21,6 +21,7 @@
 #include "run_console.h"
 #include "run_files.h"
 #include "run_profile.h"
+#include "timing_groups.h"
 #include "verdict.h"
 #include "worker.h"
 
@@ -49,6 +50,7 @@ PoolOutcome run_tests(const std::vector<TestCase>& tests, const RunOptions& o, c
     size_t batches = 0;
     for (const ChainBatches& c : chains) batches += c.size();
     BatchQueue queue(chains);
+    const std::vector<int> renders = timing_renders(tests, timing_repeats); // tests of a timing group share theirs
     std::atomic<int> done{0};
     std::atomic<bool> shader_error{false};
     std::mutex print_mutex;
@@ -62,8 +64,7 @@ PoolOutcome run_tests(const std::vector<TestCase>& tests, const RunOptions& o, c
                 bool se = false;
                 TestCase tc = tests[i];
                 if (o.stability) tc.stability.enabled = true;
-                const int repeats = tc.timing_repeats ? tc.timing_repeats : timing_repeats; // the test's own wins
-                results[i] = run_test(tc, *w, store, out_dir, flip_threads, repeats, se);
+                results[i] = run_test(tc, *w, store, out_dir, flip_threads, renders[i], se);
                 if (se) shader_error = true;
                 int n = ++done;
                 if (!o.quiet) {
@@ -90,6 +91,7 @@ PoolOutcome run_tests(const std::vector<TestCase>& tests, const RunOptions& o, c
                 throw;
             }
         });
+    share_timings(tests, timing_repeats, results);
     json driver;
     for (const auto& w : workers)
         if (json d = w->renderer.driver_json(); !d.empty()) driver = d;

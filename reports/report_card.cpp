@@ -131,8 +131,11 @@ void cost_html(std::string& o, const json& t) {
         parts.push_back(fmt::format("texture fetches/pixel <b>{}</b>", fmt_num(*f)));
     if (auto fr = num(t, "frame_ms")) {
         const json& s = sub(t, "frame_ms_samples");
+        // With a timing group, the samples are the renders of every test matching it (timing_groups.h).
+        const std::string group = str(t, "timing_group");
         if (s.is_array() && s.size() > 1 && s.front().is_number() && s.back().is_number())
-            parts.push_back(fmt::format("frame <b>{} ms</b> (median of {}, range {}&ndash;{})", fmt_num(*fr), s.size(),
+            parts.push_back(fmt::format("frame <b>{} ms</b> (median of {}{}, range {}&ndash;{})", fmt_num(*fr), s.size(),
+                                        group.empty() ? "" : " renders of <span class=\"mono\">" + e(group) + "</span>",
                                         fmt_num(s.front().get<double>()), fmt_num(s.back().get<double>())));
         else
             parts.push_back(fmt::format("frame <b>{} ms</b> (one timing)", fmt_num(*fr)));

@@ -78,8 +78,8 @@ Accuracy accuracy_from_json(const json& j) {
 
 // The render's figures, flat in the test object.
 void write_render(json& j, const RenderFigures& r) {
-    const auto& [width, height, timings, precompute_ms, frame_ms, frame_ms_samples, texture_fetches_per_pixel, texture_bytes,
-                 texel_count, cost, provenance] = r; // every member: a new one must be written here
+    const auto& [width, height, timings, precompute_ms, frame_ms, frame_ms_samples, timing_group, texture_fetches_per_pixel,
+                 texture_bytes, texel_count, cost, provenance] = r; // every member: a new one must be written here
     j["width"] = width;
     j["height"] = height;
     j["timings"] = json::array();
@@ -87,6 +87,7 @@ void write_render(json& j, const RenderFigures& r) {
     j["precompute_ms"] = precompute_ms;
     j["frame_ms"] = frame_ms;
     if (!frame_ms_samples.empty()) j["frame_ms_samples"] = frame_ms_samples;
+    if (!timing_group.empty()) j["timing_group"] = timing_group;
     j["texture_fetches_per_pixel"] = texture_fetches_per_pixel;
     if (texture_bytes) j["texture_bytes"] = *texture_bytes;
     if (texel_count) j["texel_count"] = *texel_count;
@@ -103,6 +104,7 @@ std::optional<RenderFigures> render_from_json(const json& j) {
     r.precompute_ms = number_or_nan(j, "precompute_ms");
     r.frame_ms = number_or_nan(j, "frame_ms");
     r.frame_ms_samples = j.value("frame_ms_samples", std::vector<double>{});
+    r.timing_group = j.value("timing_group", std::string());
     r.texture_fetches_per_pixel = number_or_nan(j, "texture_fetches_per_pixel");
     r.texture_bytes = optional_of<uint64_t>(j, "texture_bytes");
     r.texel_count = optional_of<uint64_t>(j, "texel_count");
@@ -314,6 +316,7 @@ const std::vector<Field>& fields(ResultsObject object) {
                                             {"precompute_ms", T::number, false, true},
                                             {"frame_ms", T::number, false, true},
                                             {"frame_ms_samples", T::array, false, true},
+                                            {"timing_group", T::string, false, true},
                                             {"profile", T::object},
                                             {"texture_fetches_per_pixel", T::number, false, true},
                                             {"texture_bytes", T::number, false, true},

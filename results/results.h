@@ -72,6 +72,9 @@ struct RenderFigures {
     double precompute_ms = 0;
     double frame_ms = 0;                  // the median of frame_ms_samples when timings are repeated
     std::vector<double> frame_ms_samples; // sorted; empty (not written) without repeats
+    // The tests whose renders the samples pool (harness/timing_groups.h): this test's name with the
+    // environment as "*"; empty (not written) when they are the test's own.
+    std::string timing_group;
     double texture_fetches_per_pixel = 0;
     std::optional<uint64_t> texture_bytes, texel_count; // the sampled environment texture, when there is one
     nlohmann::json cost;                                // {texture_fetches_per_pixel, spirv_instructions_per_pixel}

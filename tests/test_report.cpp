@@ -297,4 +297,24 @@ TEST(Report, ResultsWithoutEXRsShowThePNGs) {
     EXPECT_NE(fail.find("worst 16&times;16 block at (96,16)"), std::string::npos);
     EXPECT_FALSE(fs::exists(out / "data"));
 }
+// A test's card says whose renders its frame time pools (harness/timing_groups.h): the group's
+// pattern, escaped, after the count; a test timed alone says only the count.
+TEST(Report, TheCardNamesTheTimingGroupItsFrameTimePools) {
+    auto& f = testutil::small_run();
+    json r = f.results;
+    for (json& t : r["tests"])
+        if (t["name"] == "sampled.roughness_sweep.studio.samples=64")
+            t["timing_group"] = "sampled.roughness_sweep.*.<samples=64>";
+    const fs::path out = f.root / "timing_group";
+    report::write_report(r, f.results_dir, out);
+    const std::string card = section_of(slurp(out / "index.html"), "sampled.roughness_sweep.studio.samples=64");
+    ASSERT_FALSE(card.empty());
+    EXPECT_NE(
+        card.find("frame <b>31 ms</b> (median of 3 renders of <span class=\"mono\">sampled.roughness_sweep.*.&lt;samples=64&gt;"
+                  "</span>, range 24&ndash;70)"),
+        std::string::npos)
+        << card.substr(0, 6000);
+    const std::string alone = section_of(slurp(f.out_dir / "index.html"), "sampled.roughness_sweep.studio.samples=64");
+    EXPECT_NE(alone.find("frame <b>31 ms</b> (median of 3, range 24&ndash;70)"), std::string::npos);
+}
 } // namespace test_report

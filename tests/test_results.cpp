@@ -84,6 +84,7 @@ TestResult full_test() {
     r.precompute_ms = 2;
     r.frame_ms = 1.5;
     r.frame_ms_samples = {1.5, 1.6};
+    r.timing_group = "mobile.spheres.*.default";
     r.texture_fetches_per_pixel = 7;
     r.texture_bytes = 4096;
     r.texel_count = 1024;

@@ -21,6 +21,7 @@
 #include "harness/metrics_store.h"
 #include "harness/runner.h"
 #include "harness/suite.h"
+#include "harness/timing_groups.h"
 #include "image_io/image_io.h"
 #include "kernel/hash.h"
 #include "kernel/profile.h"
@@ -716,6 +717,123 @@ TEST(RunFacts, ATestsOwnTimingRepeatsWinsOverTheSuites) {
         err = e.what();
     }
     EXPECT_NE(err.find("tests[0].timing_repeats: must be an integer in 1..20"), std::string::npos) << err;
+    fs::remove_all(dir);
+}
+
+namespace {
+TestCase timed_case(const std::string& method, const std::string& env, const std::string& variant = "default") {
+    TestCase tc;
+    tc.spec.method = method;
+    tc.spec.scene = "roughness_sweep";
+    tc.spec.env = env;
+    tc.variant = variant;
+    tc.name = method + ".roughness_sweep." + env + "." + variant;
+    return tc;
+}
+TestResult timed_result(double frame_ms, std::vector<double> samples = {}, double ipp = 100) {
+    TestResult r;
+    RenderFigures f;
+    f.width = 64;
+    f.height = 32;
+    f.texel_count = 1000;
+    f.texture_bytes = 8000;
+    f.cost = {{"spirv_instructions_per_pixel", ipp}, {"texture_fetches_per_pixel", 4}};
+    f.frame_ms = frame_ms;
+    f.frame_ms_samples = std::move(samples);
+    r.render = f;
+    return r;
+}
+} // namespace
+
+// Tests that differ only in their environment run the same shading work, so with repeated timings
+// they form one group named by a pattern over their names; the CPU reference (its cost may follow
+// the environment) and a suite without repeats have none (harness/timing_groups.h).
+TEST(TimingGroups, TestsThatDifferOnlyInTheirEnvironmentShareOneGroup) {
+    EXPECT_EQ(timing_group(timed_case("mobile", "studio"), 3), "mobile.roughness_sweep.*.default");
+    EXPECT_EQ(timing_group(timed_case("mobile", "blender:sunrise"), 3), timing_group(timed_case("mobile", "sky_sun"), 3));
+    EXPECT_EQ(timing_group(timed_case("sampled", "studio", "samples=64"), 3), "sampled.roughness_sweep.*.samples=64");
+    EXPECT_NE(timing_group(timed_case("mobile", "studio", "storage=rgbm8"), 3), timing_group(timed_case("mobile", "studio"), 3));
+    EXPECT_EQ(timing_group(timed_case("reference", "studio", "spp=64"), 3), "");
+    EXPECT_EQ(timing_group(timed_case("mobile", "studio"), 1), "");
+}
+
+// A group of n renders each member ceil(R / n) times: at least R samples in all, as one test alone
+// has. The nightly's 47 four-environment groups rendered 3 times each were 59 s of its 175 s.
+TEST(TimingGroups, EachMemberRendersItsShareOfTheRepeats) {
+    std::vector<TestCase> tests;
+    for (const char* env : {"studio", "sky_sun", "blender:sunrise", "blender:interior"})
+        tests.push_back(timed_case("mobile", env));
+    for (const char* env : {"studio", "sky_sun"}) tests.push_back(timed_case("sampled", env, "samples=16"));
+    tests.push_back(timed_case("mobile", "studio", "storage=rgbm8")); // alone
+    tests.push_back(timed_case("reference", "studio", "spp=64"));
+    tests.back().timing_repeats = 1; // its own, as the nightly's
+    tests.push_back(timed_case("mobile", "sky_sun", "storage=rgbm8"));
+    tests.back().timing_repeats = 2; // a member that asks for other repeats is not in the rgbm8 group
+    EXPECT_EQ(timing_renders(tests, 3), (std::vector<int>{1, 1, 1, 1, 2, 2, 3, 1, 2}));
+    EXPECT_EQ(timing_renders(tests, 1), (std::vector<int>{1, 1, 1, 1, 1, 1, 1, 1, 2}));
+}
+
+// After the renders every member reports the group's samples, sorted, and their median; a member
+// whose render turned out to be other work (here a different instruction count) keeps its own, and
+// one whose render failed is left out.
+TEST(TimingGroups, MembersReportTheGroupsSamplesAndMedian) {
+    std::vector<TestCase> tests;
+    for (const char* env : {"studio", "sky_sun", "blender:sunrise", "blender:interior", "constant:1"})
+        tests.push_back(timed_case("mobile", env));
+    std::vector<TestResult> results{timed_result(14), timed_result(10), timed_result(12), timed_result(30, {}, 250),
+                                    TestResult{}};
+    share_timings(tests, 3, results);
+    for (size_t i : {0, 1, 2}) {
+        ASSERT_TRUE(results[i].render);
+        EXPECT_EQ(results[i].render->frame_ms_samples, (std::vector<double>{10, 12, 14})) << i;
+        EXPECT_EQ(results[i].render->frame_ms, 12) << i;
+        EXPECT_EQ(results[i].render->timing_group, "mobile.roughness_sweep.*.default") << i;
+    }
+    EXPECT_EQ(results[3].render->frame_ms, 30);
+    EXPECT_TRUE(results[3].render->frame_ms_samples.empty());
+    EXPECT_EQ(results[3].render->timing_group, "");
+    EXPECT_FALSE(results[4].render);
+
+    // Two members of two renders each: four samples, the median between the middle two.
+    std::vector<TestCase> two{timed_case("sampled", "studio"), timed_case("sampled", "sky_sun")};
+    std::vector<TestResult> r2{timed_result(2, {1, 3}), timed_result(3, {2, 4})};
+    share_timings(two, 3, r2);
+    EXPECT_EQ(r2[1].render->frame_ms_samples, (std::vector<double>{1, 2, 3, 4}));
+    EXPECT_EQ(r2[0].render->frame_ms, 2.5);
+    const json j = to_json(r2[0]);
+    EXPECT_EQ(j["timing_group"], "sampled.roughness_sweep.*.default");
+    EXPECT_EQ(j.get<TestResult>().render->timing_group, "sampled.roughness_sweep.*.default");
+}
+
+// A run renders the members of a group their share of the repeats and writes the pooled timings:
+// two furnace tests that differ in their constant environment, 3 repeats, so 2 renders each and 4
+// samples; a test alone still renders 3 times. Before timing groups each rendered 3 times alone.
+TEST(TimingGroups, ARunPoolsTheRendersOfAGroup) {
+    const fs::path dir = temp_dir("timing_groups");
+    write_file(dir / "g.json", R"({
+  "suite": "g",
+  "defaults": {"timing_repeats": 3, "size": "64x32"},
+  "tests": [{"scene": "furnace", "method": "mobile", "env": ["constant:1", "constant:0.5"],
+             "baseline": false, "reference": false, "measure_only": true},
+            {"scene": "furnace", "method": "mobile", "env": "constant:1", "options": {"storage": "rgbm8"},
+             "baseline": false, "reference": false, "measure_only": true}]
+})");
+    RunOptions o;
+    o.suite = (dir / "g.json").string();
+    o.goldens = dir / "goldens";
+    fs::create_directories(o.goldens / "baseline"); // measure_only tests read no golden
+    o.quiet = true;
+    const RunSummary run = run_suite(o);
+    ASSERT_EQ(run.exit_code(), kExitPass);
+    const json& t = run.results["tests"];
+    ASSERT_EQ(t.size(), 3u);
+    for (int i : {0, 1}) {
+        EXPECT_EQ(t[i]["timing_group"], "mobile.furnace.*.size=64x32") << t[i].dump();
+        EXPECT_EQ(t[i]["frame_ms_samples"].size(), 4u) << t[i].dump();
+        EXPECT_EQ(t[i]["frame_ms"], t[0]["frame_ms"]);
+    }
+    EXPECT_FALSE(t[2].contains("timing_group")) << t[2].dump();
+    EXPECT_EQ(t[2]["frame_ms_samples"].size(), 3u) << t[2].dump();
     fs::remove_all(dir);
 }
 
