@@ -16,8 +16,9 @@ void parse_shard(const std::string& s, int& index, int& count) {
         throw UsageError("--shard '" + s + "' is not INDEX/COUNT (0-based index)");
 }
 
-// Runs the suite `repeat` - 1 more times (no outputs, quiet) and prints every verdict that differs
-// from `first`'s; a change turns a pass into a regression.
+// Runs the suite `repeat` - 1 more times (no outputs, quiet; temporal sequences rendered whole, not
+// read from the store) and prints every verdict that differs from `first`'s; a change turns a pass
+// into a regression.
 void repeat_runs(const RunOptions& run, RunSummary& first, int repeat, int& exit_code) {
     for (int k = 1; k < repeat; ++k) {
         RunOptions again = run;
@@ -26,6 +27,7 @@ void repeat_runs(const RunOptions& run, RunSummary& first, int repeat, int& exit
         again.json.clear();
         again.history.clear();
         again.quiet = true;
+        again.stored_sequences = false; // every frame rendered again: the repeats look for renders that change
         RunSummary next = run_suite(again);
         int changed = 0;
         for (size_t i = 0; i < first.results["tests"].size(); ++i) {

@@ -77,7 +77,9 @@ PoolOutcome run_tests(const std::vector<TestCase>& tests, const RunOptions& o, c
         int(std::min<size_t>(size_t(std::max(jobs, 1)), batches)), jobs,
         [&] {
             try {
-                return std::make_unique<Worker>(o.device);
+                auto w = std::make_unique<Worker>(o.device);
+                w->stored_sequences = o.stored_sequences;
+                return w;
             } catch (...) {
                 queue.close(); // the other workers stop after their batch
                 throw;

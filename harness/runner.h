@@ -34,9 +34,10 @@ struct RunOptions {
     std::string device;            // Vulkan device override
     std::string command_line;      // for the report
     bool quiet = false;
-    bool force = false;     // replace an earlier run's --out, overwrite --json and --junit files
-    bool report = true;     // write index.html when out_dir is set
-    bool stability = false; // measure determinism, noise floors and margins for every test
+    bool force = false;           // replace an earlier run's --out, overwrite --json and --junit files
+    bool report = true;           // write index.html when out_dir is set
+    bool stability = false;       // measure determinism, noise floors and margins for every test
+    bool stored_sequences = true; // temporal frames after the first may come from the store (sequence_store.h)
     // --findings: `iblcheck explain/explore --json` files for the report's findings (nightly_findings.h)
     std::vector<nlohmann::json> findings;
     bool profile = false; // print where the time went (run_profile.h); each test's results gain "profile"

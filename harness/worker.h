@@ -17,6 +17,9 @@ struct Worker {
     Renderer renderer;
     std::string device;
     std::map<std::string, std::vector<cv::Mat>> sequences;
+    // Whether frames after the first may come from the sequence store (sequence_store.h); `run
+    // --repeat` renders them all again, since it looks for renders that change between runs.
+    bool stored_sequences = true;
 
     // The display-transformed frames 0..frames-1 of `spec` (cached). Throws InputError naming the
     // frame when one has non-finite pixels.

@@ -53,9 +53,9 @@ ratio() { printf '  %-28s %.2f wall, %.2f CPU\n' "$1/$2" "$(echo "${wall[$1]} / 
 echo "[bench] $(nproc) cores; this: $(git -C "$root" rev-parse --short HEAD), base: $base_rev ($base_dir)"
 echo "ci suite (iblcheck run --suite ci -q):"
 store="$tmp/precompute"
-# The counting twin's and the metrics' stores (issue 33) start empty with the precompute store:
+# The counting twin's, the metrics' and the sequences' stores (issue 33) start empty with the precompute store:
 # cold is cold.
-export IBLCHECK_COST_CACHE="$tmp/cost" IBLCHECK_METRICS_CACHE="$tmp/metrics"
+export IBLCHECK_COST_CACHE="$tmp/cost" IBLCHECK_METRICS_CACHE="$tmp/metrics" IBLCHECK_SEQUENCE_CACHE="$tmp/sequences"
 measure base_ci_first "$base_dir" build/iblcheck run --suite ci -q
 IBLCHECK_PRECOMPUTE_CACHE="$store" measure this_ci_cold "$root" build/iblcheck run --suite ci -q
 measure base_ci "$base_dir" build/iblcheck run --suite ci -q

@@ -20,6 +20,7 @@
 #include "harness/golden_store.h"
 #include "harness/metrics_store.h"
 #include "harness/runner.h"
+#include "harness/sequence_store.h"
 #include "harness/suite.h"
 #include "harness/timing_groups.h"
 #include "image_io/image_io.h"
@@ -834,6 +835,127 @@ TEST(TimingGroups, ARunPoolsTheRendersOfAGroup) {
     }
     EXPECT_FALSE(t[2].contains("timing_group")) << t[2].dump();
     EXPECT_EQ(t[2]["frame_ms_samples"].size(), 3u) << t[2].dump();
+    fs::remove_all(dir);
+}
+
+namespace {
+// A frame of `rows` x 4 pixels whose every value is `v`.
+cv::Mat frame_of(float v, int rows = 3) { return cv::Mat(rows, 4, CV_32FC3, cv::Scalar::all(v)); }
+bool same_bytes(const cv::Mat& a, const cv::Mat& b) {
+    return a.size() == b.size() && a.type() == b.type() && std::memcmp(a.data, b.data, a.total() * a.elemSize()) == 0;
+}
+} // namespace
+
+// A sequence's entry is named by every input its frames depend on: any spec field but the frame
+// index, the frame count, the shader sources, driver and environment its first frame's render
+// recorded, and the renderer code (sequence_store.h). Each changed input names another entry.
+TEST(SequenceStore, EveryInputNamesAnotherEntry) {
+    TestSpec spec;
+    spec.scene = "bumpy_sphere";
+    spec.env = "sky_sun";
+    spec.options.set("specular_aa", "off");
+    const json prov = {{"shader_tree_hash", "s1"}, {"driver", {{"driver", "llvmpipe"}}}, {"env_hash", "e1"}, {"wall_ms", 3}};
+    const std::string key = sequence_store_key(spec, 16, prov, "tool1");
+    TestSpec frame = spec;
+    frame.options.set("frame", "7");
+    json timed = prov;
+    timed["wall_ms"] = 9; // what the render measured is no input
+    EXPECT_EQ(sequence_store_key(frame, 16, timed, "tool1"), key);
+    std::set<std::string> keys{key};
+    TestSpec other = spec;
+    other.options.set("specular_aa", "toksvig");
+    keys.insert(sequence_store_key(other, 16, prov, "tool1"));
+    other = spec;
+    other.env = "studio";
+    keys.insert(sequence_store_key(other, 16, prov, "tool1"));
+    other = spec;
+    other.width = 64;
+    keys.insert(sequence_store_key(other, 16, prov, "tool1"));
+    other = spec;
+    other.shader = "/team/ibl.glsl";
+    keys.insert(sequence_store_key(other, 16, prov, "tool1"));
+    keys.insert(sequence_store_key(spec, 32, prov, "tool1"));
+    keys.insert(sequence_store_key(spec, 16, prov, "tool2"));
+    for (const char* k : {"shader_tree_hash", "driver", "env_hash"}) {
+        json p = prov;
+        p[k] = "changed";
+        keys.insert(sequence_store_key(spec, 16, p, "tool1"));
+    }
+    EXPECT_EQ(keys.size(), 10u) << "a changed input named an entry another input already names";
+}
+
+// An entry is read back byte for byte, and only whole and for the first frame it was stored with:
+// a first frame that renders differently now, another frame count, a truncated file or the store
+// turned off is a miss.
+TEST(SequenceStore, ReadsBackOnlyTheWholeEntryOfTheSameFirstFrame) {
+    const fs::path dir = temp_dir("sequence_store");
+    setenv("IBLCHECK_SEQUENCE_CACHE", dir.c_str(), 1);
+    const std::vector<cv::Mat> frames{frame_of(0.25f), frame_of(0.5f), frame_of(1e30f)};
+    save_sequence("k", frames);
+    const std::optional<std::vector<cv::Mat>> back = load_sequence("k", frame_of(0.25f), 3);
+    ASSERT_TRUE(back);
+    ASSERT_EQ(back->size(), 3u);
+    for (size_t i = 0; i < 3; ++i) EXPECT_TRUE(same_bytes((*back)[i], frames[i])) << i;
+    EXPECT_FALSE(load_sequence("k", frame_of(0.2500001f), 3)) << "frame 0 renders differently now";
+    EXPECT_FALSE(load_sequence("k", frame_of(0.25f, 2), 3)) << "another size";
+    EXPECT_FALSE(load_sequence("k", frame_of(0.25f), 2)) << "another frame count";
+    EXPECT_FALSE(load_sequence("other", frame_of(0.25f), 3));
+    const fs::path entry = dir / "k.frames";
+    ASSERT_TRUE(fs::exists(entry));
+    fs::resize_file(entry, fs::file_size(entry) - 1);
+    EXPECT_FALSE(load_sequence("k", frame_of(0.25f), 3)) << "truncated";
+    save_sequence("k", frames);
+    setenv("IBLCHECK_SEQUENCE_CACHE", "0", 1);
+    EXPECT_FALSE(load_sequence("k", frame_of(0.25f), 3)) << "the store is off";
+    unsetenv("IBLCHECK_SEQUENCE_CACHE");
+    fs::remove_all(dir);
+}
+
+// A temporal test's sequences are kept after the first run and a second run reads them: the same
+// temporal figures, bit for bit, with one entry per sequence (the test's, specular_aa=off's and the
+// supersampled reference's; the off test's own sequence is the off one). That the second run read
+// them shows when their last frames are blacked out: its figures change; a run that does not read
+// the store (`run --repeat`'s repeats) renders every frame again and scores as the first.
+TEST(SequenceStore, ASecondRunReadsTheSequencesAndScoresThemTheSame) {
+    const fs::path dir = temp_dir("sequence_run");
+    write_file(dir / "t.json", R"({
+  "suite": "t",
+  "defaults": {"env": "constant:1", "size": "32x32"},
+  "tests": [{"scene": "bumpy_sphere", "method": "mobile", "options": {"ssaa": 1},
+             "variants": [{"specular_aa": "off"}, {"specular_aa": "toksvig"}],
+             "baseline": false, "reference": false, "measure_only": true, "temporal": {"frames": 4, "reference_ssaa": 2}}]
+})");
+    const fs::path store = dir / "sequences";
+    setenv("IBLCHECK_SEQUENCE_CACHE", store.c_str(), 1);
+    RunOptions o;
+    o.suite = (dir / "t.json").string();
+    o.goldens = dir / "goldens";
+    fs::create_directories(o.goldens / "baseline");
+    o.quiet = true;
+    const auto temporal_of = [&](bool stored) {
+        o.stored_sequences = stored;
+        const RunSummary run = run_suite(o);
+        EXPECT_EQ(run.exit_code(), kExitPass);
+        return run.results["tests"][0]["temporal"].dump() + run.results["tests"][1]["temporal"].dump();
+    };
+    const std::string first = temporal_of(true);
+    std::vector<fs::path> entries;
+    if (fs::is_directory(store))
+        for (const auto& e : fs::directory_iterator(store))
+            if (e.path().extension() == ".frames") entries.push_back(e.path());
+    EXPECT_EQ(entries.size(), 3u);
+    EXPECT_NE(first.find("flicker"), std::string::npos) << first;
+    EXPECT_EQ(temporal_of(true), first);
+    for (const fs::path& e : entries) { // the last frame (32 x 32 RGB floats) black, the size kept
+        std::string bytes = read_text(e);
+        const size_t frame = 32 * 32 * 3 * sizeof(float);
+        ASSERT_GT(bytes.size(), frame);
+        std::fill(bytes.end() - long(frame), bytes.end(), '\0');
+        write_file(e, bytes);
+    }
+    EXPECT_NE(temporal_of(true), first) << "the second run did not read the stored frames";
+    EXPECT_EQ(temporal_of(false), first);
+    unsetenv("IBLCHECK_SEQUENCE_CACHE");
     fs::remove_all(dir);
 }
 
