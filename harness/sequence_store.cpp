@@ -8,16 +8,11 @@
 #include "kernel/store_entry.h"
 #include "renderers/vulkan/shader_compiler.h"
 
-namespace fs = std::filesystem;
-using nlohmann::json;
-
 namespace iblcheck {
 
 namespace {
 
 constexpr char kMagic[] = "IBLSEQ01"; // this layout; another is a miss
-
-fs::path entry_path(const std::string& key) { return sequence_store_dir() / (key + ".frames"); }
 
 // A frame's header: its size and OpenCV type, as 32-bit values.
 struct FrameShape {
@@ -26,7 +21,7 @@ struct FrameShape {
 };
 
 // The provenance's part that stands for an input; "none" where the render did not record it.
-std::string part(const json& provenance, const char* key) {
+std::string part(const nlohmann::json& provenance, const char* key) {
     const auto it = provenance.find(key);
     return it == provenance.end() ? "none" : it->dump();
 }
@@ -39,9 +34,11 @@ std::string spec_text(const TestSpec& s) {
 
 } // namespace
 
-fs::path sequence_store_dir() { return store_dir("IBLCHECK_SEQUENCE_CACHE", vk::spirv_cache_dir().parent_path() / "sequences"); }
+std::filesystem::path sequence_store_dir() {
+    return store_dir("IBLCHECK_SEQUENCE_CACHE", vk::spirv_cache_dir().parent_path() / "sequences");
+}
 
-std::string sequence_store_key(const TestSpec& spec, int frames, const json& provenance, const std::string& tool) {
+std::string sequence_store_key(const TestSpec& spec, int frames, const nlohmann::json& provenance, const std::string& tool) {
     TestSpec s = spec;
     s.options.erase("frame"); // the sequence's frames, all of them
     Fnv1a64 h;
@@ -55,7 +52,8 @@ std::string sequence_store_key(const TestSpec& spec, int frames, const json& pro
 
 std::optional<std::vector<cv::Mat>> load_sequence(const std::string& key, const cv::Mat& first, int frames) {
     if (sequence_store_dir().empty() || frames < 1) return std::nullopt;
-    const std::optional<std::string> entry = read_store_entry(entry_path(key), std::string(kMagic) + key);
+    const std::optional<std::string> entry =
+        read_store_entry(sequence_store_dir() / (key + ".frames"), std::string(kMagic) + key);
     FrameShape shape;
     if (!entry || entry->size() < sizeof shape) return std::nullopt;
     std::memcpy(&shape, entry->data(), sizeof shape);
@@ -84,7 +82,7 @@ void save_sequence(const std::string& key, const std::vector<cv::Mat>& frames) {
         const cv::Mat m = f.isContinuous() ? f : f.clone();
         bytes.append(reinterpret_cast<const char*>(m.data), shape.bytes());
     }
-    write_store_entry(entry_path(key), bytes);
+    write_store_entry(sequence_store_dir() / (key + ".frames"), bytes);
 }
 
 } // namespace iblcheck

@@ -683,6 +683,19 @@ TEST(RunFacts, StartedIsTakenBeforeTheTests) {
     EXPECT_LE(started, before + 1) << "started " << run.results["started"] << ", the run took " << took << " s";
 }
 
+namespace {
+// Options that run the suite file `suite` of measure-only tests quietly: its goldens folder beside
+// it, empty (such tests read no golden).
+RunOptions measure_only_run(const fs::path& suite) {
+    RunOptions o;
+    o.suite = suite.string();
+    o.goldens = suite.parent_path() / "goldens";
+    fs::create_directories(o.goldens / "baseline");
+    o.quiet = true;
+    return o;
+}
+} // namespace
+
 // A test's own "timing_repeats" wins over the suite's: the nightly renders its CPU reference once (its
 // three 64-spp renders were 68 s of a warm nightly's 158 s, and nobody gates on that time), every
 // other test three times. A test's value outside 1..20 is an error naming it.
@@ -699,11 +712,7 @@ TEST(RunFacts, ATestsOwnTimingRepeatsWinsOverTheSuites) {
     ASSERT_EQ(suite.tests.size(), 2u);
     EXPECT_EQ(suite.tests[0].timing_repeats, 0); // the suite's
     EXPECT_EQ(suite.tests[1].timing_repeats, 1);
-    RunOptions o;
-    o.suite = (dir / "r.json").string();
-    o.goldens = dir / "goldens";
-    fs::create_directories(o.goldens / "baseline"); // measure_only tests read no golden
-    o.quiet = true;
+    RunOptions o = measure_only_run(dir / "r.json");
     const RunSummary run = run_suite(o);
     ASSERT_EQ(run.exit_code(), kExitPass);
     EXPECT_EQ(run.results["tests"][0]["frame_ms_samples"].size(), 3u);
@@ -819,11 +828,7 @@ TEST(TimingGroups, ARunPoolsTheRendersOfAGroup) {
             {"scene": "furnace", "method": "mobile", "env": "constant:1", "options": {"storage": "rgbm8"},
              "baseline": false, "reference": false, "measure_only": true}]
 })");
-    RunOptions o;
-    o.suite = (dir / "g.json").string();
-    o.goldens = dir / "goldens";
-    fs::create_directories(o.goldens / "baseline"); // measure_only tests read no golden
-    o.quiet = true;
+    RunOptions o = measure_only_run(dir / "g.json");
     const RunSummary run = run_suite(o);
     ASSERT_EQ(run.exit_code(), kExitPass);
     const json& t = run.results["tests"];
@@ -927,11 +932,7 @@ TEST(SequenceStore, ASecondRunReadsTheSequencesAndScoresThemTheSame) {
 })");
     const fs::path store = dir / "sequences";
     setenv("IBLCHECK_SEQUENCE_CACHE", store.c_str(), 1);
-    RunOptions o;
-    o.suite = (dir / "t.json").string();
-    o.goldens = dir / "goldens";
-    fs::create_directories(o.goldens / "baseline");
-    o.quiet = true;
+    RunOptions o = measure_only_run(dir / "t.json");
     const auto temporal_of = [&](bool stored) {
         o.stored_sequences = stored;
         const RunSummary run = run_suite(o);
