@@ -6,12 +6,14 @@
 // sampled method the source cube, both cube_size texels a face whatever the environment's file, and
 // neither branches on texel values. Their frame times measure one thing. So the tests of such a
 // group are rendered ceil(R / n) times each (n members), not R times, and every member reports the
-// median and range of the group's samples: at least R of them, as before, spread over the run.
+// median and range of the group's samples: at least R of them when every member renders, as one
+// test alone has, spread over the run.
 //
 // Measured on the nightly of 2026-11-27 (47 groups of four environments, 3 renders a test): the
-// spread of the four environments' medians (median 7 %, p90 10 % of the median) was no larger than
-// one test's own three renders (median 4 %, p90 11 %), with no environment faster throughout. The
-// group's 164 + 24 repeat renders were 59 s of a 175-s warm nightly.
+// spread of the four environments' medians (median 7 %, p90 10 % of the median; renders minutes
+// apart) was of the size of one test's own three (median 4 %, p90 11 %; renders a second apart),
+// and no environment was faster throughout. The
+// second and third renders of the groups' 188 tests were 59 s of frame time in a 175-s warm nightly.
 //
 // The grouping is checked after the renders, not assumed: a member whose render differs from the
 // group's first in image size, texture texels or bytes, or deterministic cost (the counting twin's
