@@ -41,9 +41,11 @@ namespace {
 using namespace iblcheck::testutil;
 
 // The binary as the commands it prints name it from this folder (kernel/program.h): its relative
-// path when shorter than the absolute one (it is not on PATH here).
+// path when shorter than the absolute one (it is not on PATH here), "./iblcheck" from its own
+// folder (a bare name would search PATH; started from build/ this test expected "iblcheck").
 std::string printed_bin() {
-    const std::string rel = fs::path(built("iblcheck")).lexically_relative(fs::current_path()).string();
+    std::string rel = fs::path(built("iblcheck")).lexically_relative(fs::current_path()).string();
+    if (rel.find('/') == std::string::npos) rel = "./" + rel;
     return rel.size() < built("iblcheck").size() ? rel : built("iblcheck");
 }
 
