@@ -31,6 +31,15 @@ SequenceScore score_sequence(const std::vector<cv::Mat>& test, const std::vector
     s.flip_mean /= double(test.size());
     return s;
 }
+// score_sequence of two sequences the worker holds, computed once per worker (Worker::sequence_scores).
+SequenceScore held_score(Worker& w, const std::vector<cv::Mat>& test, const std::vector<cv::Mat>& ref, int flip_threads) {
+    const auto [it, fresh] = w.sequence_scores.try_emplace({&test, &ref});
+    if (fresh) {
+        const SequenceScore s = score_sequence(test, ref, flip_threads);
+        it->second = {s.flicker, s.variation_ratio, s.flip_mean};
+    }
+    return {it->second[0], it->second[1], it->second[2]};
+}
 } // namespace
 
 TemporalOutcome run_temporal(const TestCase& tc, Worker& w, const GoldenStore& store, const fs::path& img_dir,
@@ -40,8 +49,9 @@ TemporalOutcome run_temporal(const TestCase& tc, Worker& w, const GoldenStore& s
     const auto& test_frames = w.sequence(tc.spec, ts.frames);
     const auto& off_frames = w.sequence(off, ts.frames);
     const auto& ref_frames = w.sequence(ref, ts.frames);
-    SequenceScore st = score_sequence(test_frames, ref_frames, flip_threads);
-    SequenceScore so = score_sequence(off_frames, ref_frames, flip_threads);
+    // The `off` test's own sequence is the off one (the same object): its two scores are one.
+    SequenceScore st = held_score(w, test_frames, ref_frames, flip_threads);
+    SequenceScore so = held_score(w, off_frames, ref_frames, flip_threads);
     TemporalOutcome out;
     json& j = out.json;
     j = {{"frames_count", ts.frames},
@@ -64,7 +74,7 @@ TemporalOutcome run_temporal(const TestCase& tc, Worker& w, const GoldenStore& s
         std::vector<cv::Mat> truth_frames;
         for (const cv::Mat& m : truth_linear) truth_frames.push_back(display_transform(m));
         const SequenceScore tt = score_sequence(test_frames, truth_frames, flip_threads);
-        const SequenceScore to = score_sequence(off_frames, truth_frames, flip_threads);
+        const SequenceScore to = &off_frames == &test_frames ? tt : score_sequence(off_frames, truth_frames, flip_threads);
         const SequenceScore tr = score_sequence(ref_frames, truth_frames, flip_threads);
         j["truth"] = {
             {"golden", store.relative(truth->image_path)},

@@ -22,7 +22,9 @@
 #include "harness/runner.h"
 #include "harness/sequence_store.h"
 #include "harness/suite.h"
+#include "harness/temporal_check.h"
 #include "harness/timing_groups.h"
+#include "harness/worker.h"
 #include "image_io/image_io.h"
 #include "kernel/hash.h"
 #include "kernel/profile.h"
@@ -957,6 +959,34 @@ TEST(SequenceStore, ASecondRunReadsTheSequencesAndScoresThemTheSame) {
     EXPECT_NE(temporal_of(true), first) << "the second run did not read the stored frames";
     EXPECT_EQ(temporal_of(false), first);
     unsetenv("IBLCHECK_SEQUENCE_CACHE");
+    fs::remove_all(dir);
+}
+
+// Every specular-AA variant of a scene scores the same `off` sequence against the same reference:
+// a worker scores each pair of the sequences it holds once, and the `off` test, whose own sequence
+// is the off one, scores it once, not twice. The variants' figures are those of a worker that
+// scored everything afresh.
+TEST(TemporalScores, AWorkerScoresEachPairOfItsSequencesOnce) {
+    const fs::path dir = temp_dir("temporal_scores");
+    write_file(dir / "t.json", R"({
+  "suite": "t",
+  "defaults": {"env": "constant:1", "size": "32x32"},
+  "tests": [{"scene": "bumpy_sphere", "method": "mobile", "options": {"ssaa": 1},
+             "variants": [{"specular_aa": "off"}, {"specular_aa": "toksvig"}, {"specular_aa": "rjump"}],
+             "baseline": false, "reference": false, "measure_only": true, "temporal": {"frames": 4, "reference_ssaa": 2}}]
+})");
+    const Suite suite = load_suite((dir / "t.json").string());
+    ASSERT_EQ(suite.tests.size(), 3u);
+    const GoldenStore store(dir / "goldens");
+    Worker w("");
+    std::vector<std::string> shared;
+    for (const TestCase& tc : suite.tests) shared.push_back(run_temporal(tc, w, store, {}, "", 0).json.dump());
+    // (off, reference), (toksvig, reference), (rjump, reference): three pairs for six scores.
+    EXPECT_EQ(w.sequence_scores.size(), 3u);
+    for (size_t i = 0; i < suite.tests.size(); ++i) {
+        Worker fresh("");
+        EXPECT_EQ(run_temporal(suite.tests[i], fresh, store, {}, "", 0).json.dump(), shared[i]) << suite.tests[i].name;
+    }
     fs::remove_all(dir);
 }
 
