@@ -918,6 +918,20 @@ TEST(SequenceStore, ReadsBackOnlyTheWholeEntryOfTheSameFirstFrame) {
     fs::remove_all(dir);
 }
 
+namespace {
+// A suite file of bumpy_sphere temporal tests in `dir` (32x32, 4 frames, the reference at 2x2 rays),
+// one per specular_aa value: measure-only, so nothing but the sequences is rendered.
+fs::path small_temporal_suite(const fs::path& dir, const std::vector<std::string>& specular_aa) {
+    std::string variants;
+    for (const std::string& v : specular_aa) variants += (variants.empty() ? "" : ", ") + ("{\"specular_aa\": \"" + v + "\"}");
+    write_file(dir / "t.json", R"({"suite": "t", "defaults": {"env": "constant:1", "size": "32x32"},
+  "tests": [{"scene": "bumpy_sphere", "method": "mobile", "options": {"ssaa": 1}, "variants": [)" +
+                                   variants + R"(],
+             "baseline": false, "reference": false, "measure_only": true, "temporal": {"frames": 4, "reference_ssaa": 2}}]})");
+    return dir / "t.json";
+}
+} // namespace
+
 // A temporal test's sequences are kept after the first run and a second run reads them: the same
 // temporal figures, bit for bit, with one entry per sequence (the test's, specular_aa=off's and the
 // supersampled reference's; the off test's own sequence is the off one). That the second run read
@@ -925,16 +939,10 @@ TEST(SequenceStore, ReadsBackOnlyTheWholeEntryOfTheSameFirstFrame) {
 // the store (`run --repeat`'s repeats) renders every frame again and scores as the first.
 TEST(SequenceStore, ASecondRunReadsTheSequencesAndScoresThemTheSame) {
     const fs::path dir = temp_dir("sequence_run");
-    write_file(dir / "t.json", R"({
-  "suite": "t",
-  "defaults": {"env": "constant:1", "size": "32x32"},
-  "tests": [{"scene": "bumpy_sphere", "method": "mobile", "options": {"ssaa": 1},
-             "variants": [{"specular_aa": "off"}, {"specular_aa": "toksvig"}],
-             "baseline": false, "reference": false, "measure_only": true, "temporal": {"frames": 4, "reference_ssaa": 2}}]
-})");
+    const fs::path suite = small_temporal_suite(dir, {"off", "toksvig"});
     const fs::path store = dir / "sequences";
     setenv("IBLCHECK_SEQUENCE_CACHE", store.c_str(), 1);
-    RunOptions o = measure_only_run(dir / "t.json");
+    RunOptions o = measure_only_run(suite);
     const auto temporal_of = [&](bool stored) {
         o.stored_sequences = stored;
         const RunSummary run = run_suite(o);
@@ -968,14 +976,7 @@ TEST(SequenceStore, ASecondRunReadsTheSequencesAndScoresThemTheSame) {
 // scored everything afresh.
 TEST(TemporalScores, AWorkerScoresEachPairOfItsSequencesOnce) {
     const fs::path dir = temp_dir("temporal_scores");
-    write_file(dir / "t.json", R"({
-  "suite": "t",
-  "defaults": {"env": "constant:1", "size": "32x32"},
-  "tests": [{"scene": "bumpy_sphere", "method": "mobile", "options": {"ssaa": 1},
-             "variants": [{"specular_aa": "off"}, {"specular_aa": "toksvig"}, {"specular_aa": "rjump"}],
-             "baseline": false, "reference": false, "measure_only": true, "temporal": {"frames": 4, "reference_ssaa": 2}}]
-})");
-    const Suite suite = load_suite((dir / "t.json").string());
+    const Suite suite = load_suite(small_temporal_suite(dir, {"off", "toksvig", "rjump"}).string());
     ASSERT_EQ(suite.tests.size(), 3u);
     const GoldenStore store(dir / "goldens");
     Worker w("");
