@@ -2,7 +2,6 @@
 
 #include <fmt/core.h>
 
-#include <algorithm>
 #include <chrono>
 
 #include "artefacts.h"
@@ -16,6 +15,7 @@
 #include "renderers/environments/environment.h"
 #include "stability.h"
 #include "temporal_check.h"
+#include "timing_groups.h"
 #include "verdict.h"
 
 namespace fs = std::filesystem;
@@ -69,10 +69,7 @@ void repeat_timings(RenderFigures& figures, const TestCase& tc, Worker& w, int r
         for (auto& p : w.renderer.render(tc.spec).timings) f += p.precompute ? 0 : p.ms;
         frame.push_back(f);
     }
-    std::sort(frame.begin(), frame.end());
-    const size_t n = frame.size();
-    figures.frame_ms_samples = frame;
-    figures.frame_ms = n % 2 ? frame[n / 2] : 0.5 * (frame[n / 2 - 1] + frame[n / 2]);
+    set_frame_samples(figures, std::move(frame));
 }
 
 // One test under way: what its checks read, and what they found (the verdicts in order and the

@@ -22,12 +22,14 @@ std::string group_key(const TestCase& tc, int suite_repeats) {
 // What makes two renders the same work (timing_groups.h): checked, not assumed.
 auto work_of(const RenderFigures& f) { return std::tuple(f.width, f.height, f.texel_count, f.texture_bytes, f.cost.dump()); }
 
-double median_of_sorted(const std::vector<double>& v) {
-    const size_t n = v.size();
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
 } // namespace
+
+void set_frame_samples(RenderFigures& f, std::vector<double> samples) {
+    std::sort(samples.begin(), samples.end());
+    const size_t n = samples.size();
+    if (n) f.frame_ms = n % 2 ? samples[n / 2] : 0.5 * (samples[n / 2 - 1] + samples[n / 2]);
+    f.frame_ms_samples = std::move(samples);
+}
 
 int timing_repeats_of(const TestCase& tc, int suite_repeats) { return tc.timing_repeats ? tc.timing_repeats : suite_repeats; }
 
@@ -74,11 +76,9 @@ void share_timings(const std::vector<TestCase>& tests, int suite_repeats, std::v
             else
                 samples.insert(samples.end(), f.frame_ms_samples.begin(), f.frame_ms_samples.end());
         }
-        std::sort(samples.begin(), samples.end());
         for (size_t i : same) {
             RenderFigures& f = *results[i].render;
-            f.frame_ms_samples = samples;
-            f.frame_ms = median_of_sorted(samples);
+            set_frame_samples(f, samples);
             f.timing_group = timing_group(tests[i], timing_repeats_of(tests[i], suite_repeats));
         }
     }

@@ -40,6 +40,10 @@ std::string timing_group(const TestCase& tc, int repeats);
 // How many times to render each test: ceil(R / n) for a member of a group of n, R alone.
 std::vector<int> timing_renders(const std::vector<TestCase>& tests, int suite_repeats);
 
+// A render's frame times: `samples` sorted into frame_ms_samples, their median as frame_ms. The one
+// place that says what a repeated timing reports (a test's own repeats and a group's alike).
+void set_frame_samples(RenderFigures& f, std::vector<double> samples);
+
 // After the renders: each group's members get the group's samples (sorted), their median as
 // frame_ms, and the group's name in timing_group; a member that does not match the group (see
 // above) or whose render failed keeps its own.
