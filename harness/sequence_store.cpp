@@ -26,24 +26,23 @@ std::string part(const nlohmann::json& provenance, const char* key) {
     return it == provenance.end() ? "none" : it->dump();
 }
 
-// Every field of the spec (its frame index erased by the caller).
-std::string spec_text(const TestSpec& s) {
-    return s.method + "|" + s.scene + "|" + s.env + "|" + s.env_name + "|" + std::to_string(s.width) + "x" +
-           std::to_string(s.height) + "|" + s.options.canonical() + "|frame=" + std::to_string(s.frame) + "|" + s.shader;
-}
-
 } // namespace
+
+std::string sequence_spec_text(TestSpec s, int frames) {
+    s.options.erase("frame"); // the sequence's frames, all of them
+    return s.method + "|" + s.scene + "|" + s.env + "|" + s.env_name + "|" + std::to_string(s.width) + "x" +
+           std::to_string(s.height) + "|" + s.options.canonical() + "|frame=" + std::to_string(s.frame) + "|" + s.shader +
+           "|frames=" + std::to_string(frames);
+}
 
 std::filesystem::path sequence_store_dir() {
     return store_dir("IBLCHECK_SEQUENCE_CACHE", vk::spirv_cache_dir().parent_path() / "sequences");
 }
 
 std::string sequence_store_key(const TestSpec& spec, int frames, const nlohmann::json& provenance, const std::string& tool) {
-    TestSpec s = spec;
-    s.options.erase("frame"); // the sequence's frames, all of them
     Fnv1a64 h;
     h.update("tool=" + tool + ";" + kMagic + ";");
-    h.update(spec_text(s) + ";frames=" + std::to_string(frames) + ";");
+    h.update(sequence_spec_text(spec, frames) + ";");
     for (const char* key : {"shader_tree_hash", "driver", "env_hash"})
         h.update(std::string(key) + "=" + part(provenance, key) + ";");
     h.update("cpu=" + llvmpipe_caps().cpu_class());

@@ -29,6 +29,10 @@ namespace iblcheck {
 // Where entries go: $IBLCHECK_SEQUENCE_CACHE, else <SPIR-V cache's parent>/sequences; empty when off.
 std::filesystem::path sequence_store_dir();
 
+// Which sequence `frames` frames of `spec` are: every field of the spec but its frame index, and
+// the count (the worker's sequences in memory and this store's names).
+std::string sequence_spec_text(TestSpec spec, int frames);
+
 // The entry's name for `frames` frames of `spec` whose first frame's render recorded `provenance`.
 std::string sequence_store_key(const TestSpec& spec, int frames, const nlohmann::json& provenance,
                                const std::string& tool = render_code_hash());

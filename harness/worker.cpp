@@ -21,9 +21,7 @@ vk::ContextOptions context_options(const std::string& device) {
 Worker::Worker(const std::string& device) : renderer(context_options(device)), device(device) {}
 
 const std::vector<cv::Mat>& Worker::sequence(TestSpec spec, int frames) {
-    std::string key = spec.method + "|" + spec.scene + "|" + spec.env + "|" + std::to_string(spec.width) + "x" +
-                      std::to_string(spec.height) + "|" + spec.options.canonical() + "|" + std::to_string(frames) + "|" +
-                      spec.shader;
+    const std::string key = sequence_spec_text(spec, frames);
     auto it = sequences.find(key);
     if (it != sequences.end()) return it->second;
     const auto render_frame = [&](int f) {
