@@ -37,13 +37,20 @@ uint32_t nested_uniform_scramble(uint32_t x, uint32_t seed) {
     return reverse_bits(x);
 }
 
-// Sobol dimension 1 (primitive polynomial x + 1); dimension 0 is reverse_bits(index).
-uint32_t sobol_dim1(uint32_t index) {
-    uint32_t v = 1u << 31, r = 0;
-    for (; index; index >>= 1, v ^= v >> 1)
-        if (index & 1) r ^= v;
-    return r;
-}
+// Sobol dimension 1's XORs a byte at a time: bytes[b][x] is the XOR of the direction numbers v_{8b+k}
+// (env_distribution.h) for the set bits k of x.
+struct SobolDim1Bytes {
+    uint32_t bytes[4][256];
+    constexpr SobolDim1Bytes() : bytes{} {
+        uint32_t v[32] = {1u << 31};
+        for (int k = 1; k < 32; ++k) v[k] = v[k - 1] ^ (v[k - 1] >> 1);
+        for (int b = 0; b < 4; ++b)
+            for (uint32_t x = 0; x < 256; ++x)
+                for (int k = 0; k < 8; ++k)
+                    if ((x >> k) & 1u) bytes[b][x] ^= v[8 * b + k];
+    }
+};
+constexpr SobolDim1Bytes kSobolDim1;
 
 uint32_t hash_combine(uint32_t seed, uint32_t v) { return seed ^ (v + 0x9e3779b9u + (seed << 6) + (seed >> 2)); }
 } // namespace
@@ -56,6 +63,11 @@ uint32_t hash_u32(uint32_t x) {
     x *= 0x846ca68bu;
     x ^= x >> 16;
     return x;
+}
+
+uint32_t sobol_dim1(uint32_t index) {
+    const auto& t = kSobolDim1.bytes;
+    return t[0][index & 0xFFu] ^ t[1][(index >> 8) & 0xFFu] ^ t[2][(index >> 16) & 0xFFu] ^ t[3][index >> 24];
 }
 
 void sobol_owen_2d(uint32_t index, uint32_t seed, double& x, double& y) {

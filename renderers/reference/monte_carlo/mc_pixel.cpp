@@ -65,14 +65,17 @@ bool intersect_candidates(const Scene& scene, const std::vector<int>& cand, Vec3
     return true;
 }
 
-PixelOut render_pixel(const PixelContext& ctx, int x, int y, int P, int M, uint32_t pat, uint32_t pix_seed,
-                      const std::vector<int>& cand, long& fetches) {
+PixelOut render_pixel(const PixelContext& ctx, int x, int y, int P, int M, uint32_t pat, uint32_t pix_seed, PixelScratch& scratch,
+                      long& fetches) {
     PixelOut po;
+    const std::vector<int>& cand = scratch.cand;
     const LightSeeds seeds{hash_u32(pix_seed ^ 0x68bc21ebu), hash_u32(pix_seed ^ 0x02e5be93u), hash_u32(pix_seed ^ 0x7b3f9a11u)};
     double acc[3] = {0, 0, 0}, s1 = 0, s2 = 0;
     int hits = 0;
-    std::vector<EnvWindow> wins(cand.size());
-    std::vector<char> win_built(cand.size(), 0);
+    std::vector<EnvWindow>& wins = scratch.windows;
+    if (wins.size() < cand.size()) wins.resize(cand.size());
+    std::vector<char>& win_built = scratch.built;
+    win_built.assign(cand.size(), 0);
     if (!cand.empty())
         for (int k = 0; k < P; ++k) {
             double sx, sy;

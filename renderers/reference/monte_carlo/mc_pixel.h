@@ -8,6 +8,7 @@
 #include "kernel/vec3.h"
 #include "renderers/reference/monte_carlo/mc_material.h"
 #include "renderers/reference/monte_carlo/mc_shade.h"
+#include "renderers/reference/monte_carlo/mc_window.h"
 #include "renderers/scenes/scene.h"
 
 namespace iblcheck::reference {
@@ -38,11 +39,20 @@ struct PixelOut {
     double coverage = 0, lum_mean = 0, lum_var = 0;
 };
 
-// Pixel (x, y): P sub-pixel positions from the pattern key `pattern` (the same for every lighting seed);
-// at each position that hits a candidate sphere, M lighting samples (Sobol indices k·M .. k·M + M − 1 of
-// the pixel's lighting sequence, key `pixel_seed`). A sphere's window (mc_window.h) is built at its first
-// hit in the pixel.
+// A worker's buffers, kept from pixel to pixel: the pixel's candidate spheres (pixel_candidates) and their
+// windows. A window is four arrays of the environment's cells (8192 doubles each at 128x64 cells);
+// allocated and cleared for every pixel they were a tenth of a 64-spp render's time.
+struct PixelScratch {
+    std::vector<int> cand;
+    std::vector<EnvWindow> windows;
+    std::vector<char> built;
+};
+
+// Pixel (x, y) among the spheres scratch.cand: P sub-pixel positions from the pattern key `pattern` (the
+// same for every lighting seed); at each position that hits a candidate sphere, M lighting samples (Sobol
+// indices k·M .. k·M + M − 1 of the pixel's lighting sequence, key `pixel_seed`). A sphere's window
+// (mc_window.h) is built at its first hit in the pixel.
 PixelOut render_pixel(const PixelContext& ctx, int x, int y, int P, int M, uint32_t pattern, uint32_t pixel_seed,
-                      const std::vector<int>& cand, long& fetches);
+                      PixelScratch& scratch, long& fetches);
 
 } // namespace iblcheck::reference

@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <set>
 
 using namespace iblcheck;
 using namespace iblcheck::reference;
@@ -53,26 +55,60 @@ TEST(McPixel, CoverageIsTheFractionOfPositionsThatHit) {
     const Shader shader{img, dist, McLobes::all, true, true};
     const std::vector<MatConst> mats = {mat_const(scene.spheres[0].material, McLobes::all)};
     const PixelContext ctx{scene, W, H, shader, mats, false};
-    std::vector<int> cand;
+    PixelScratch scratch;
+    std::vector<int>& cand = scratch.cand;
     long fetches = 0;
     pixel_candidates(scene, W, H, W / 2, H / 2, cand);
-    const PixelOut inside = render_pixel(ctx, W / 2, H / 2, 16, 2, 1, 2, cand, fetches);
+    const PixelOut inside = render_pixel(ctx, W / 2, H / 2, 16, 2, 1, 2, scratch, fetches);
     EXPECT_EQ(inside.coverage, 1.0);
     EXPECT_GT(inside.rgb[0], 0);
     EXPECT_GE(inside.lum_var, 0);
     EXPECT_GT(fetches, 0);
     pixel_candidates(scene, W, H, 0, 0, cand);
-    const PixelOut corner = render_pixel(ctx, 0, 0, 16, 2, 1, 2, cand, fetches);
+    const PixelOut corner = render_pixel(ctx, 0, 0, 16, 2, 1, 2, scratch, fetches);
     EXPECT_EQ(corner.coverage, 0.0);
     EXPECT_EQ(corner.rgb[0], 0.0);
     // A silhouette pixel: some positions hit. Find one along the centre row.
     for (int x = 0; x < W / 2; ++x) {
         pixel_candidates(scene, W, H, x, H / 2, cand);
-        const PixelOut p = render_pixel(ctx, x, H / 2, 64, 1, 1, 2, cand, fetches);
+        const PixelOut p = render_pixel(ctx, x, H / 2, 64, 1, 1, 2, scratch, fetches);
         if (p.coverage == 0) continue;
         EXPECT_LT(p.coverage, 1.0) << "the first pixel that hits is on the silhouette";
         EXPECT_EQ(std::fmod(p.coverage * 64, 1.0), 0.0);
         break;
     }
+}
+// A worker's scratch is reused from pixel to pixel: a pixel renders the same bits after any other as
+// with fresh scratch, whatever window the last pixel left there (another sphere's, another material's).
+TEST(McPixel, ReusedScratchRendersEachPixelAsFreshScratchDoes) {
+    const Scene scene = build_scene("sphere_field", OptionMap{});
+    const int W = scene.width, H = scene.height;
+    const Environment env = load_environment("sky_sun");
+    const EnvDistribution dist(env);
+    cv::Mat equirect = env.equirect.clone();
+    const EnvImage img(equirect);
+    const Shader shader{img, dist, McLobes::all, true, true};
+    std::vector<MatConst> mats;
+    for (const Sphere& s : scene.spheres) mats.push_back(mat_const(s.material, McLobes::all));
+    const PixelContext ctx{scene, W, H, shader, mats, false};
+    PixelScratch reused;
+    std::set<int> spheres;
+    int compared = 0;
+    for (int y = 0; y < H; y += 7)
+        for (int x = 0; x < W; x += 5) {
+            long f1 = 0, f2 = 0;
+            pixel_candidates(scene, W, H, x, y, reused.cand);
+            if (reused.cand.empty()) continue;
+            PixelScratch fresh;
+            fresh.cand = reused.cand;
+            const PixelOut a = render_pixel(ctx, x, y, 8, 2, 3, uint32_t(x * 977 + y), reused, f1);
+            const PixelOut b = render_pixel(ctx, x, y, 8, 2, 3, uint32_t(x * 977 + y), fresh, f2);
+            ASSERT_EQ(std::memcmp(&a, &b, sizeof a), 0) << x << "," << y;
+            ASSERT_EQ(f1, f2);
+            spheres.insert(reused.cand[0]);
+            ++compared;
+        }
+    EXPECT_GT(compared, 50);
+    EXPECT_GT(spheres.size(), 4u) << "pixels of several spheres, one after another";
 }
 } // namespace mc_pixel_test

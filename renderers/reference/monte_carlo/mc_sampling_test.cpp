@@ -19,6 +19,26 @@ constexpr double kPi = model::kPi;
 double length(Vec3d v) { return std::sqrt(dot(v, v)); }
 } // namespace
 
+// Sobol dimension 1 is its definition, a direction number per set bit of the index: the first points
+// (0, 1/2, 3/4, 1/4, 5/8, 1/8, 3/8, 7/8), every single bit, and random indices against the loop over bits.
+TEST(McSampling, SobolDimensionOneIsTheXorOfItsDirectionNumbers) {
+    auto by_bits = [](uint32_t index) {
+        uint32_t v = 1u << 31, r = 0;
+        for (; index; index >>= 1, v ^= v >> 1)
+            if (index & 1) r ^= v;
+        return r;
+    };
+    const double first[8] = {0, 0.5, 0.75, 0.25, 0.625, 0.125, 0.375, 0.875};
+    for (uint32_t i = 0; i < 8; ++i) EXPECT_EQ(sobol_dim1(i) / 4294967296.0, first[i]) << i;
+    for (int k = 0; k < 32; ++k) EXPECT_EQ(sobol_dim1(1u << k), by_bits(1u << k)) << "bit " << k;
+    EXPECT_EQ(sobol_dim1(0xFFFFFFFFu), by_bits(0xFFFFFFFFu));
+    uint32_t index = 12345;
+    for (int n = 0; n < 100000; ++n) {
+        index = hash_u32(index + 1);
+        ASSERT_EQ(sobol_dim1(index), by_bits(index)) << index;
+    }
+}
+
 TEST(McSampling, ShadingFrameIsOrthonormalAndRoundTrips) {
     for (const Vec3d n : {Vec3d{0, 0, 1}, Vec3d{0, 0, -1}, normalize(Vec3d{1, 2, 3}), normalize(Vec3d{-0.3, 0.9, -0.1})}) {
         const ShadingFrame f(n);

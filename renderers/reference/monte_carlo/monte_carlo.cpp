@@ -87,8 +87,8 @@ std::string estimator_description(bool window, bool lobe_window, double compensa
 }
 
 // Each row's pixels are written by that row alone, from hashes of the pixel and the seed: the same
-// bits for any thread count. A worker keeps its candidates list as scratch.
-std::vector<int> candidates_scratch() { return {}; }
+// bits for any thread count. A worker keeps its candidates and windows as scratch.
+reference::PixelScratch pixel_scratch() { return {}; }
 
 // The pilot pass of the adaptive counts (mc_adaptive.h): its own lighting keys, independent of the main
 // pass's; min(P, 32) positions of the pattern × 2 lighting samples per pixel. Returns the counts; adds the
@@ -101,14 +101,14 @@ std::vector<int> pilot_counts(const PixelContext& ctx, const McOptions& opt, uin
     const uint32_t pilot_hash = hash_u32(seed_hash ^ 0x3c6ef372u);
     const int pilot_pos = std::min(opt.positions, 32);
     std::atomic<long> pilot_n{0};
-    parallel_for(H, threads, candidates_scratch, [&](int y, std::vector<int>& cand) {
+    parallel_for(H, threads, pixel_scratch, [&](int y, reference::PixelScratch& scratch) {
         long f = 0;
         for (int x = 0; x < W; ++x) {
             const uint32_t pix = hash_u32(uint32_t(y) * uint32_t(W) + uint32_t(x));
-            pixel_candidates(ctx.scene, W, H, x, y, cand);
-            if (cand.empty()) continue;
+            pixel_candidates(ctx.scene, W, H, x, y, scratch.cand);
+            if (scratch.cand.empty()) continue;
             PixelOut po =
-                render_pixel(ctx, x, y, pilot_pos, 2, hash_u32(pattern_hash ^ pix), hash_u32(pilot_hash ^ pix), cand, f);
+                render_pixel(ctx, x, y, pilot_pos, 2, hash_u32(pattern_hash ^ pix), hash_u32(pilot_hash ^ pix), scratch, f);
             double mu = po.coverage * po.lum_mean;
             r[size_t(y) * W + x] = std::sqrt(po.lum_var) / std::sqrt(mu * mu + 0.01);
             if (po.coverage < 1) partial[size_t(y) * W + x] = 1; // silhouette (or a sliver the pilot missed)
@@ -123,14 +123,14 @@ std::vector<int> pilot_counts(const PixelContext& ctx, const McOptions& opt, uin
 void main_pass(const PixelContext& ctx, const McOptions& opt, uint32_t seed_hash, uint32_t pattern_hash, int threads,
                const std::vector<int>& counts, cv::Mat& image, cv::Mat& coverage, std::vector<long>& row_fetches) {
     const int W = ctx.W;
-    parallel_for(ctx.H, threads, candidates_scratch, [&](int y, std::vector<int>& cand) {
+    parallel_for(ctx.H, threads, pixel_scratch, [&](int y, reference::PixelScratch& scratch) {
         long fetches = 0;
         for (int x = 0; x < W; ++x) {
             const uint32_t pix = hash_u32(uint32_t(y) * uint32_t(W) + uint32_t(x));
             const uint32_t pix_seed = hash_u32(seed_hash ^ pix);
             const uint32_t pat_seed = hash_u32(pattern_hash ^ pix);
-            pixel_candidates(ctx.scene, W, ctx.H, x, y, cand);
-            PixelOut po = render_pixel(ctx, x, y, opt.positions, counts[size_t(y) * W + x], pat_seed, pix_seed, cand, fetches);
+            pixel_candidates(ctx.scene, W, ctx.H, x, y, scratch.cand);
+            PixelOut po = render_pixel(ctx, x, y, opt.positions, counts[size_t(y) * W + x], pat_seed, pix_seed, scratch, fetches);
             auto& px = image.at<cv::Vec3f>(y, x);
             for (int i = 0; i < 3; ++i) px[i] = float(po.rgb[i]);
             coverage.at<float>(y, x) = float(po.coverage);
