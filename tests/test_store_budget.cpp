@@ -160,6 +160,23 @@ TEST(StoreBudget, AHitMakesAnEntryRecentlyUsed) {
     EXPECT_FALSE(fs::exists(unread));
 }
 
+// An entry reads back byte for byte after its head, whatever its size and bytes (zeros included); a file
+// shorter than the head, another head or no file is a miss.
+TEST(StoreBudget, AnEntryReadsBackWholeAfterItsHead) {
+    const Scratch scratch("store_entry_read");
+    const fs::path d = scratch.dir / "precompute";
+    std::string big(3u << 20, '\0');
+    for (size_t i = 0; i < big.size(); ++i) big[i] = char((i * 2654435761u) >> 13);
+    write_store_entry(d / "big.ibl", "MAGIC" + big);
+    EXPECT_EQ(read_store_entry(d / "big.ibl", "MAGIC"), std::optional<std::string>(big));
+    write_store_entry(d / "empty.ibl", "MAGIC");
+    EXPECT_EQ(read_store_entry(d / "empty.ibl", "MAGIC"), std::optional<std::string>(""));
+    write_store_entry(d / "short.ibl", "MAG");
+    EXPECT_EQ(read_store_entry(d / "short.ibl", "MAGIC"), std::nullopt);
+    EXPECT_EQ(read_store_entry(d / "big.ibl", "MAGIK"), std::nullopt);
+    EXPECT_EQ(read_store_entry(d / "none.ibl", "MAGIC"), std::nullopt);
+}
+
 TEST(StoreBudget, BudgetComesFromTheEnvironmentAndABadValueIsNamed) {
     {
         BudgetEnv e(nullptr);
