@@ -45,64 +45,73 @@ TEST(McPixel, CandidatesAreConservativeAndIntersectAsTheScene) {
     EXPECT_GT(hits, 0);
 }
 
+namespace {
+// One pixel's context: the scene and environment named, every sphere's material, all lobes, the window.
+struct Pixels {
+    Scene scene;
+    int W, H;
+    Environment env;
+    EnvDistribution dist;
+    cv::Mat equirect;
+    EnvImage img;
+    Shader shader;
+    std::vector<MatConst> mats;
+    PixelContext ctx;
+    Pixels(const std::string& scene_name, const std::string& env_name)
+        : scene(build_scene(scene_name, OptionMap{})), W(scene.width), H(scene.height), env(load_environment(env_name)),
+          dist(env), equirect(env.equirect.clone()), img(equirect), shader{img, dist, McLobes::all, true, true},
+          mats(materials(scene)), ctx{scene, W, H, shader, mats, false} {}
+    Pixels(const Pixels&) = delete; // the context refers to the members
+    static std::vector<MatConst> materials(const Scene& s) {
+        std::vector<MatConst> m;
+        for (const Sphere& sp : s.spheres) m.push_back(mat_const(sp.material, McLobes::all));
+        return m;
+    }
+};
+} // namespace
+
 TEST(McPixel, CoverageIsTheFractionOfPositionsThatHit) {
-    const Scene scene = build_scene("sphere", OptionMap{});
-    const int W = scene.width, H = scene.height;
-    const Environment env = load_environment("constant:1");
-    const EnvDistribution dist(env);
-    cv::Mat equirect = env.equirect.clone();
-    const EnvImage img(equirect);
-    const Shader shader{img, dist, McLobes::all, true, true};
-    const std::vector<MatConst> mats = {mat_const(scene.spheres[0].material, McLobes::all)};
-    const PixelContext ctx{scene, W, H, shader, mats, false};
+    const Pixels px("sphere", "constant:1");
     PixelScratch scratch;
     std::vector<int>& cand = scratch.cand;
     long fetches = 0;
-    pixel_candidates(scene, W, H, W / 2, H / 2, cand);
-    const PixelOut inside = render_pixel(ctx, W / 2, H / 2, 16, 2, 1, 2, scratch, fetches);
+    pixel_candidates(px.scene, px.W, px.H, px.W / 2, px.H / 2, cand);
+    const PixelOut inside = render_pixel(px.ctx, px.W / 2, px.H / 2, 16, 2, 1, 2, scratch, fetches);
     EXPECT_EQ(inside.coverage, 1.0);
     EXPECT_GT(inside.rgb[0], 0);
     EXPECT_GE(inside.lum_var, 0);
     EXPECT_GT(fetches, 0);
-    pixel_candidates(scene, W, H, 0, 0, cand);
-    const PixelOut corner = render_pixel(ctx, 0, 0, 16, 2, 1, 2, scratch, fetches);
+    pixel_candidates(px.scene, px.W, px.H, 0, 0, cand);
+    const PixelOut corner = render_pixel(px.ctx, 0, 0, 16, 2, 1, 2, scratch, fetches);
     EXPECT_EQ(corner.coverage, 0.0);
     EXPECT_EQ(corner.rgb[0], 0.0);
     // A silhouette pixel: some positions hit. Find one along the centre row.
-    for (int x = 0; x < W / 2; ++x) {
-        pixel_candidates(scene, W, H, x, H / 2, cand);
-        const PixelOut p = render_pixel(ctx, x, H / 2, 64, 1, 1, 2, scratch, fetches);
+    for (int x = 0; x < px.W / 2; ++x) {
+        pixel_candidates(px.scene, px.W, px.H, x, px.H / 2, cand);
+        const PixelOut p = render_pixel(px.ctx, x, px.H / 2, 64, 1, 1, 2, scratch, fetches);
         if (p.coverage == 0) continue;
         EXPECT_LT(p.coverage, 1.0) << "the first pixel that hits is on the silhouette";
         EXPECT_EQ(std::fmod(p.coverage * 64, 1.0), 0.0);
         break;
     }
 }
+
 // A worker's scratch is reused from pixel to pixel: a pixel renders the same bits after any other as
 // with fresh scratch, whatever window the last pixel left there (another sphere's, another material's).
 TEST(McPixel, ReusedScratchRendersEachPixelAsFreshScratchDoes) {
-    const Scene scene = build_scene("sphere_field", OptionMap{});
-    const int W = scene.width, H = scene.height;
-    const Environment env = load_environment("sky_sun");
-    const EnvDistribution dist(env);
-    cv::Mat equirect = env.equirect.clone();
-    const EnvImage img(equirect);
-    const Shader shader{img, dist, McLobes::all, true, true};
-    std::vector<MatConst> mats;
-    for (const Sphere& s : scene.spheres) mats.push_back(mat_const(s.material, McLobes::all));
-    const PixelContext ctx{scene, W, H, shader, mats, false};
+    const Pixels px("sphere_field", "sky_sun");
     PixelScratch reused;
     std::set<int> spheres;
     int compared = 0;
-    for (int y = 0; y < H; y += 7)
-        for (int x = 0; x < W; x += 5) {
+    for (int y = 0; y < px.H; y += 7)
+        for (int x = 0; x < px.W; x += 5) {
             long f1 = 0, f2 = 0;
-            pixel_candidates(scene, W, H, x, y, reused.cand);
+            pixel_candidates(px.scene, px.W, px.H, x, y, reused.cand);
             if (reused.cand.empty()) continue;
             PixelScratch fresh;
             fresh.cand = reused.cand;
-            const PixelOut a = render_pixel(ctx, x, y, 8, 2, 3, uint32_t(x * 977 + y), reused, f1);
-            const PixelOut b = render_pixel(ctx, x, y, 8, 2, 3, uint32_t(x * 977 + y), fresh, f2);
+            const PixelOut a = render_pixel(px.ctx, x, y, 8, 2, 3, uint32_t(x * 977 + y), reused, f1);
+            const PixelOut b = render_pixel(px.ctx, x, y, 8, 2, 3, uint32_t(x * 977 + y), fresh, f2);
             ASSERT_EQ(std::memcmp(&a, &b, sizeof a), 0) << x << "," << y;
             ASSERT_EQ(f1, f2);
             spheres.insert(reused.cand[0]);
