@@ -660,9 +660,10 @@ std::time_t parse_utc(const std::string& iso) {
 // A run's `started` is its start: taken before the first test, not after the last (the nightly of
 // 2026-11-26 recorded its end, 48 minutes later, and the commit checked out by then). `started` has a
 // resolution of a second, so the run starts just after the clock's second changes and lasts over a
-// second (each of its two tests is rendered 12 times at 320x240, timing_repeats; 2.5 s on a 2-core EPYC): its end is then in a
-// later second than its start. A run that still took under a second is skipped, said. (It used to render
-// 20 times at 640x480 to last 2.5 s from any start: 23 s of a CTest run's test time.)
+// second (each of its two tests is rendered 12 times at 320x240, timing_repeats: 2.4 s on a 2-core
+// EPYC), so its end is in a later second than its start. A run that still took under a second is
+// skipped, said. (It used to render 20 times at 640x480 to last 2.5 s from any start: 23 s of a CTest
+// run's test time.)
 TEST(RunFacts, StartedIsTakenBeforeTheTests) {
     FurnaceStore store("run_started", R"({
   "suite": "mini",

@@ -40,8 +40,8 @@ struct PixelOut {
 };
 
 // A worker's buffers, kept from pixel to pixel: the pixel's candidate spheres (pixel_candidates) and their
-// windows. A window is four arrays of the environment's cells (8192 doubles each at 128x64 cells);
-// allocated and cleared for every pixel they were a tenth of a 64-spp render's time.
+// windows. A window is four arrays of the environment's cells (8192 doubles each at 128x64 cells),
+// allocated and cleared for every pixel before (perf: the clearing alone was 3 % of a 64-spp render).
 struct PixelScratch {
     std::vector<int> cand;
     std::vector<EnvWindow> windows;
