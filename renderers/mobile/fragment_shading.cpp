@@ -12,7 +12,7 @@
 namespace iblcheck {
 
 namespace {
-const std::vector<VkDescriptorType> kTypes = {kStorageBuffer, kSampled, kStorageBuffer, kSampled, kSampled};
+const std::vector<VkDescriptorType> kTypes = {kUniformBuffer, kSampled, kUniformBuffer, kSampled, kSampled};
 constexpr uint32_t kQuadVertices = 4; // a triangle strip per sphere
 
 // One draw of every sphere's impostor into `target`. With a timer, a one-pixel draw first makes

@@ -41,8 +41,12 @@ vk::Buffer upload_scene(vk::Context& ctx, const Scene& scene) {
     // A fourth vec4 per sphere (ao_pad) only when a sphere is occluded: scene.glsl declares it under
     // MATERIAL_AO, so scenes without AO keep the layout (and the shaders' code) they had.
     const bool ao = scene_uses_ao(scene);
-    const size_t header = 5 * 16, per_sphere = (ao ? 4 : 3) * 16;
-    vk::Buffer buf = ctx.create_buffer(header + per_sphere * std::max<size_t>(1, scene.spheres.size()));
+    if (scene.spheres.size() > kSceneSphereCapacity)
+        throw Error(
+            fmt::format("scene '{}' has {} spheres; the shaders' scene buffer holds at most {} (renderers/mobile/gpu_scene.h)",
+                        scene.name, scene.spheres.size(), kSceneSphereCapacity));
+    vk::Buffer buf = ctx.create_buffer(scene_buffer_bytes(ao));
+    std::memset(buf.mapped, 0, scene_buffer_bytes(ao));
     auto* f = buf.as<float>();
     const Camera& c = scene.camera;
     // scene.h: forward = normalize(target − eye), right = normalize(forward × world_up), up = right × forward.

@@ -98,9 +98,9 @@ ShadePush shade_push(const OptionMap& o, int width, int height, const Precompute
 // Bindings 0..4 of both shading paths: the spheres, the prefiltered chain, SH9, the LUT and the
 // irradiance cube (compute adds its output image at 5).
 std::vector<vk::Binding> shading_bindings(vk::Context& ctx, const vk::Buffer& scene_buf, const IblResources& ibl) {
-    return {vk::Binding::storage_buffer(0, scene_buf),
+    return {vk::Binding::uniform_buffer(0, scene_buf),
             vk::Binding::sampled_image(1, ibl.prefiltered.sampled_view, ctx.linear_sampler()),
-            vk::Binding::storage_buffer(2, ibl.sh), vk::Binding::sampled_image(3, ibl.lut.sampled_view, ctx.linear_sampler()),
+            vk::Binding::uniform_buffer(2, ibl.sh), vk::Binding::sampled_image(3, ibl.lut.sampled_view, ctx.linear_sampler()),
             vk::Binding::sampled_image(4, ibl.irradiance.sampled_view, ctx.linear_sampler())};
 }
 
@@ -149,7 +149,7 @@ std::optional<double> shade_with_compute(GpuSession& gpu, const ShadingInputs& i
     ProfileStage stage("shading");
     vk::Context& ctx = gpu.ctx();
     const int width = int(in.push.width), height = int(in.push.height);
-    const std::vector<VkDescriptorType> types = {kStorageBuffer, kSampled, kStorageBuffer, kSampled, kSampled, kStorageBuffer};
+    const std::vector<VkDescriptorType> types = {kUniformBuffer, kSampled, kUniformBuffer, kSampled, kSampled, kStorageBuffer};
     const auto& shade = gpu.pipeline("shade_spheres.comp", in.defines, types, sizeof(ShadePush), in.options);
     vk::Buffer out = ctx.create_buffer(VkDeviceSize(width) * height * 16);
     std::vector<vk::Binding> b = in.bindings;

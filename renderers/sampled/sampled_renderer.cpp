@@ -34,9 +34,9 @@ RenderResult render_sampled(GpuSession& gpu, const Environment& env, const TestS
     bool cached = false;
     auto ibl_ptr = precompute_cached(gpu, env, ps, result.timings, cached);
     const IblResources& ibl = *ibl_ptr;
-    const std::vector<VkDescriptorType> types = {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-                                                 VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-                                                 VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
+    const std::vector<VkDescriptorType> types = {VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+                                                 VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
+                                                 VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
     const vk::Defines defines = glsl_defines(shader_selections(o, "sampled")); // mip_clamp
     ProfileStage stage("shading");
     const auto& shade = gpu.pipeline("shade_sampled.comp", defines, types, sizeof(SampledPush));
@@ -55,11 +55,11 @@ RenderResult render_sampled(GpuSession& gpu, const Environment& env, const TestS
     if (pc.ssaa < 1 || pc.ssaa > 16) throw UsageError("option 'ssaa' must be in 1..16");
 
     // Bindings 3 and 4 are unused by this shader; the layout keeps the mobile numbering.
-    std::vector<vk::Binding> b = {vk::Binding::storage_buffer(0, scene_buf),
+    std::vector<vk::Binding> b = {vk::Binding::uniform_buffer(0, scene_buf),
                                   vk::Binding::sampled_image(1, ibl.source_cube.sampled_view, ctx.linear_sampler()),
-                                  vk::Binding::storage_buffer(2, ibl.sh),
-                                  vk::Binding::storage_buffer(3, ibl.sh),
-                                  vk::Binding::storage_buffer(4, ibl.sh),
+                                  vk::Binding::uniform_buffer(2, ibl.sh),
+                                  vk::Binding::uniform_buffer(3, ibl.sh),
+                                  vk::Binding::uniform_buffer(4, ibl.sh),
                                   vk::Binding::storage_buffer(5, out)};
     for (auto& [name, ms] : shade.dispatch_timed("shade_sampled", b, &pc, sizeof pc, (width + 7) / 8, (height + 7) / 8))
         result.timings.push_back({name, ms, true, false});

@@ -20,13 +20,17 @@ struct CameraGpu {
     vec4 up_pad;          // xyz up
 };
 
-layout(binding = 0, std430) readonly buffer SceneBuffer {
+// A uniform block, not a storage buffer: lavapipe loads a storage buffer lane by lane, and every ray
+// reads every sphere (renderers/mobile/gpu_scene.h has the measurement). Its fixed size is
+// gpu_scene.h's kSceneSphereCapacity: what Vulkan's minimum maxUniformBufferRange holds.
+#define SCENE_SPHERE_CAPACITY 254
+layout(binding = 0, std140) uniform SceneBuffer {
     vec4 eye_ortho;       // xyz eye, w: 1 orthographic, 0 perspective
     vec4 forward_half_h;  // xyz forward, w: orthographic half height
     vec4 right_tan_half;  // xyz right, w: tan(fov_y / 2)
     vec4 up_pad;          // xyz up
     uvec4 counts;         // x: sphere count
-    SphereGpu spheres[];
+    SphereGpu spheres[SCENE_SPHERE_CAPACITY];
 } scene;
 
 CameraGpu scene_camera() { return CameraGpu(scene.eye_ortho, scene.forward_half_h, scene.right_tan_half, scene.up_pad); }

@@ -22,7 +22,7 @@
 
 layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;
 layout(binding = 1) uniform samplerCube source;   // rgba32f box pyramid
-layout(binding = 2, std430) readonly buffer SH { vec4 coeffs[10]; } sh;
+layout(binding = 2, std140) uniform SH { vec4 coeffs[10]; } sh;  // uniform, as the scene (scene.glsl says why)
 layout(binding = 5, std430) writeonly buffer Out { vec4 pixels[]; } out_image;
 layout(push_constant) uniform Push {
     uint width;

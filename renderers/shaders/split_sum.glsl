@@ -23,7 +23,7 @@
 #endif
 
 layout(binding = 1) uniform ENV_SAMPLER prefiltered;  // a cube, or a 2D layout (env_layout.glsl)
-layout(binding = 2, std430) readonly buffer SH { vec4 coeffs[10]; } sh;
+layout(binding = 2, std140) uniform SH { vec4 coeffs[10]; } sh;  // uniform, as the scene (scene.glsl says why)
 layout(binding = 3) uniform sampler2D dfg_lut;
 layout(binding = 4) uniform samplerCube irradiance_cube;
 layout(push_constant) uniform Push {

@@ -93,6 +93,7 @@ struct Binding {
     VkSampler sampler = VK_NULL_HANDLE;
     VkImageLayout layout = VK_IMAGE_LAYOUT_GENERAL;
     static Binding storage_buffer(uint32_t b, const Buffer& buf) { return {b, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, buf.buffer}; }
+    static Binding uniform_buffer(uint32_t b, const Buffer& buf) { return {b, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, buf.buffer}; }
     static Binding storage_image(uint32_t b, VkImageView v) { return {b, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_NULL_HANDLE, v}; }
     static Binding sampled_image(uint32_t b, VkImageView v, VkSampler s) {
         return {b, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_NULL_HANDLE, v, s};
@@ -180,9 +181,9 @@ class Context {
         validation_messages_.clear();
     }
 
-    Buffer create_buffer(VkDeviceSize size, VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
-                                                                       VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
-                                                                       VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+    Buffer create_buffer(VkDeviceSize size,
+                         VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT |
+                                                    VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT);
     // A 2D image or a cube (layers = 6), with `mips` levels, usable as storage + sampled + transfer.
     Image create_image(VkFormat format, uint32_t width, uint32_t height, uint32_t mips, bool cube);
     bool format_supports(VkFormat format, VkFormatFeatureFlags features) const;
