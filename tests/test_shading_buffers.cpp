@@ -4,6 +4,7 @@
 // ci suite's shading 4x slower). These tests read the compiled SPIR-V, so a pass that goes back to
 // a storage buffer, or a scene block whose size the host no longer matches, fails here and not as a
 // slow or garbled render.
+#include <glslang/SPIRV/spirv.hpp>
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -23,7 +24,7 @@ using namespace iblcheck;
 namespace test_shading_buffers {
 
 namespace {
-// One buffer a module declares at a binding, read from its SPIR-V (numbers: SPIR-V spec, 3.x).
+// One buffer a module declares at a binding, read from its SPIR-V.
 struct BufferBlock {
     bool storage = false;           // a storage buffer (StorageBuffer class, or Uniform + BufferBlock)
     uint32_t last_array_length = 0; // the block's last member, when it is a sized array
@@ -31,16 +32,6 @@ struct BufferBlock {
 };
 
 std::map<uint32_t, BufferBlock> buffer_blocks(const std::vector<uint32_t>& spirv) {
-    enum : uint32_t {
-        OpTypeArray = 28,
-        OpTypeStruct = 30,
-        OpTypePointer = 32,
-        OpConstant = 43,
-        OpVariable = 59,
-        OpDecorate = 71
-    };
-    enum : uint32_t { DecorationBufferBlock = 3, DecorationArrayStride = 6, DecorationBinding = 33 };
-    enum : uint32_t { StorageClassUniform = 2, StorageClassStorageBuffer = 12 };
     std::map<uint32_t, uint32_t> binding, stride, constant;
     std::set<uint32_t> buffer_block;
     std::map<uint32_t, std::vector<uint32_t>> struct_members;
@@ -48,17 +39,18 @@ std::map<uint32_t, BufferBlock> buffer_blocks(const std::vector<uint32_t>& spirv
     std::map<uint32_t, std::pair<uint32_t, uint32_t>> pointer_to; // id -> (storage class, pointee)
     std::vector<std::pair<uint32_t, uint32_t>> variables;         // (pointer type, result id)
     for (size_t i = 5; i < spirv.size();) {
-        const uint32_t count = spirv[i] >> 16, op = spirv[i] & 0xffff;
+        const uint32_t count = spirv[i] >> 16;
+        const spv::Op op = spv::Op(spirv[i] & 0xffff);
         const uint32_t* w = &spirv[i];
-        if (count == 0) throw Error("malformed SPIR-V: an instruction of zero words");
-        if (op == OpDecorate && w[2] == DecorationBinding) binding[w[1]] = w[3];
-        if (op == OpDecorate && w[2] == DecorationArrayStride) stride[w[1]] = w[3];
-        if (op == OpDecorate && w[2] == DecorationBufferBlock) buffer_block.insert(w[1]);
-        if (op == OpTypeStruct) struct_members[w[1]].assign(w + 2, w + count);
-        if (op == OpTypeArray) array_of[w[1]] = {w[2], w[3]};
-        if (op == OpTypePointer) pointer_to[w[1]] = {w[2], w[3]};
-        if (op == OpConstant && count == 4) constant[w[2]] = w[3];
-        if (op == OpVariable && (w[3] == StorageClassUniform || w[3] == StorageClassStorageBuffer))
+        if (count == 0 || i + count > spirv.size()) throw Error("malformed SPIR-V at word " + std::to_string(i));
+        if (op == spv::OpDecorate && w[2] == spv::DecorationBinding) binding[w[1]] = w[3];
+        if (op == spv::OpDecorate && w[2] == spv::DecorationArrayStride) stride[w[1]] = w[3];
+        if (op == spv::OpDecorate && w[2] == spv::DecorationBufferBlock) buffer_block.insert(w[1]);
+        if (op == spv::OpTypeStruct) struct_members[w[1]].assign(w + 2, w + count);
+        if (op == spv::OpTypeArray) array_of[w[1]] = {w[2], w[3]};
+        if (op == spv::OpTypePointer) pointer_to[w[1]] = {w[2], w[3]};
+        if (op == spv::OpConstant && count == 4) constant[w[2]] = w[3];
+        if (op == spv::OpVariable && (w[3] == spv::StorageClassUniform || w[3] == spv::StorageClassStorageBuffer))
             variables.push_back({w[1], w[2]});
         i += count;
     }
@@ -67,7 +59,7 @@ std::map<uint32_t, BufferBlock> buffer_blocks(const std::vector<uint32_t>& spirv
         if (!binding.count(id)) continue;
         auto [storage_class, block] = pointer_to.at(type);
         BufferBlock b;
-        b.storage = storage_class == StorageClassStorageBuffer || buffer_block.count(block);
+        b.storage = storage_class == spv::StorageClassStorageBuffer || buffer_block.count(block);
         const std::vector<uint32_t>& members = struct_members.at(block);
         if (!members.empty() && array_of.count(members.back())) {
             b.last_array_length = constant.at(array_of.at(members.back()).second);

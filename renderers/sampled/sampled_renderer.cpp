@@ -5,6 +5,7 @@
 #include "kernel/errors.h"
 #include "kernel/profile.h"
 #include "renderers/mobile/cost_store.h"
+#include "renderers/mobile/descriptor_types.h"
 #include "renderers/mobile/gpu_scene.h"
 #include "renderers/mobile/ibl_precompute.h"
 #include "renderers/mobile/push_constants.h"
@@ -34,9 +35,8 @@ RenderResult render_sampled(GpuSession& gpu, const Environment& env, const TestS
     bool cached = false;
     auto ibl_ptr = precompute_cached(gpu, env, ps, result.timings, cached);
     const IblResources& ibl = *ibl_ptr;
-    const std::vector<VkDescriptorType> types = {VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-                                                 VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
-                                                 VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
+    const std::vector<VkDescriptorType> types = {kUniformBuffer, kSampled,       kUniformBuffer,
+                                                 kUniformBuffer, kUniformBuffer, kStorageBuffer};
     const vk::Defines defines = glsl_defines(shader_selections(o, "sampled")); // mip_clamp
     ProfileStage stage("shading");
     const auto& shade = gpu.pipeline("shade_sampled.comp", defines, types, sizeof(SampledPush));
