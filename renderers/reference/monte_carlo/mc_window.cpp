@@ -54,11 +54,8 @@ double cos_minus(double ca, double cd, double sd) {
 // bounds the computed ca·cd + sa·sd. The same bits as cos_minus wherever it is positive; half the
 // environment's cells are below a pixel's dilated horizon.
 double cos_minus_positive(double ca, double cd, double sd) {
-    if (ca >= cd) return 1.0;
-    const double cacd = ca * cd;
-    if (cacd + std::max(sd, 0.0) <= 0) return 0.0;
-    const double sa = std::sqrt(std::max(0.0, 1 - ca * ca));
-    return std::max(cacd + sa * sd, 0.0);
+    if (ca < cd && ca * cd + std::max(sd, 0.0) <= 0) return 0.0;
+    return std::max(cos_minus(ca, cd, sd), 0.0);
 }
 
 // The window's unnormalised terms per cell: factor = k̄_d·cos⁺(…) (diffuse), spec = S_c where the dilated
