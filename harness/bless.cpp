@@ -19,6 +19,7 @@
 #include "kernel/program.h"
 #include "kernel/shell_quote.h"
 #include "metrics/catalog.h"
+#include "metrics/identical.h"
 #include "metrics/image_compare.h"
 #include "provenance.h"
 #include "renderers/environments/environment.h"
@@ -31,10 +32,6 @@ using nlohmann::json;
 namespace iblcheck {
 
 namespace {
-bool bit_identical(const cv::Mat& a, const cv::Mat& b) {
-    return a.size() == b.size() && a.type() == b.type() && std::memcmp(a.data, b.data, a.total() * a.elemSize()) == 0;
-}
-
 json read_sidecar(const fs::path& exr) {
     const fs::path side = fs::path(exr).replace_extension(".json");
     if (!fs::exists(side)) return json();

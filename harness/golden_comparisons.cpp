@@ -3,7 +3,6 @@
 #include <fmt/core.h>
 
 #include <algorithm>
-#include <cstring>
 
 #include "bless.h"
 #include "kernel/errors.h"
@@ -89,8 +88,7 @@ Comparison judge_against_baseline(const TestCase& tc, const RenderResult& rr, co
     if (art) {
         std::string tag = g.label.empty() ? "baseline" : "baseline@" + safe_file_name(g.label);
         // A render bit-identical to its baseline (the usual pass) shares the test's EXR.
-        const bool same = g.image.type() == image.type() && g.image.isContinuous() && image.isContinuous() &&
-                          std::memcmp(g.image.data, image.data, image.total() * image.elemSize()) == 0;
+        const bool same = bit_identical(g.image, image);
         c.images = Artefacts::images(art.rel + "test.png", art.png(tag + ".png", g.image, !same),
                                      art.heatmap(tag + "_flip.png", flip.errmap));
         if (same) c.images["golden_exr"] = c.images["test_exr"];

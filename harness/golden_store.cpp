@@ -19,6 +19,7 @@
 #include "kernel/profile.h"
 #include "kernel/program.h"
 #include "kernel/shell_quote.h"
+#include "metrics/identical.h"
 #include "renderers/environments/environment.h"
 
 namespace fs = std::filesystem;
@@ -236,8 +237,7 @@ bool same_pixels(const fs::path& exr, const cv::Mat& image) {
     if (!fs::exists(exr, ec)) return false;
     try {
         const cv::Mat old = read_image(exr.string()).pixels;
-        return old.size() == image.size() && old.type() == image.type() && old.isContinuous() && image.isContinuous() &&
-               std::memcmp(old.data, image.data, image.total() * image.elemSize()) == 0;
+        return bit_identical(old, image);
     } catch (const Error&) {
         return false; // unreadable: replaced
     }

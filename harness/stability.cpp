@@ -3,11 +3,11 @@
 #include <fmt/core.h>
 
 #include <cmath>
-#include <cstring>
 #include <limits>
 
 #include "child_render.h"
 #include "metrics/catalog.h"
+#include "metrics/identical.h"
 #include "metrics/image_compare.h"
 #include "renderers/option_table.h"
 #include "verdict.h"
@@ -31,10 +31,6 @@ std::vector<std::string> floor_metrics(const TestCase& tc) {
     return keys;
 }
 const DisplaySpace* display_of(const TestCase& tc) { return tc.display ? &*tc.display : nullptr; }
-
-bool bit_identical(const cv::Mat& a, const cv::Mat& b) {
-    return a.size() == b.size() && a.type() == b.type() && std::memcmp(a.data, b.data, a.total() * a.elemSize()) == 0;
-}
 
 bool monte_carlo(const TestSpec& spec) { return spec.method == "sampled" || spec.method == "reference"; }
 bool on_vulkan(const TestSpec& spec) { return spec.method != "reference"; }

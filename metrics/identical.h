@@ -1,5 +1,7 @@
-// Bit-identical finite images (a render equal to its baseline, the usual pass): every metric's
-// result for them is known exactly, so FLIP, SSIM and PSNR skip their work (issue 33).
+// Bit-identical images. identical_finite: a render equal to its baseline (the usual pass), for which
+// every metric's result is known exactly, so FLIP, SSIM and PSNR skip their work (issue 33).
+// bit_identical: the same bytes, NaN and Inf included (a golden is rewritten only when its bytes
+// change; a repeated render must give the same bytes).
 #pragma once
 #include <opencv2/core.hpp>
 
@@ -18,6 +20,15 @@ inline bool identical_finite(const cv::Mat& a, const cv::Mat& b) {
         for (size_t i = 0; i < n; ++i)
             if (!std::isfinite(p[i])) return false;
     }
+    return true;
+}
+
+// Same size, type and bytes, row by row (either may be a view into a larger image).
+inline bool bit_identical(const cv::Mat& a, const cv::Mat& b) {
+    if (a.size() != b.size() || a.type() != b.type()) return false;
+    const size_t row_bytes = size_t(a.cols) * a.elemSize();
+    for (int y = 0; y < a.rows; ++y)
+        if (std::memcmp(a.ptr(y), b.ptr(y), row_bytes) != 0) return false;
     return true;
 }
 
