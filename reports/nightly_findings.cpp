@@ -42,7 +42,7 @@ struct Measured {
     double flip, ipp;
 };
 
-std::string pct(double a, double b) { return b > 0 ? fmt::format("{:+.1f} %", 100 * (a / b - 1)) : ""; }
+std::string pct_of(double a, double b) { return b > 0 ? fmt::format("{:+.1f} %", 100 * (a / b - 1)) : ""; }
 // A run names the default configuration's variant "default" (older results: "").
 bool is_default(const json& t) { return str(t, "variant").empty() || str(t, "variant") == "default"; }
 std::string variant_name(const json& t) { return is_default(t) ? "default" : str(t, "variant"); }
@@ -77,7 +77,7 @@ std::string accuracy_table(const std::map<std::string, std::vector<Measured>>& g
         const double base = d ? d->flip : 0;
         auto cell = [&](const Measured& m) {
             return fmt::format("{} <b>{}</b> <span class=\"meta\">{}</span>", e(variant_name(*m.t)), fmt_num(m.flip),
-                               pct(m.flip, base));
+                               pct_of(m.flip, base));
         };
         fmt::format_to(std::back_inserter(o),
                        "<tr><td>{}</td><td>{}</td><td>{}</td><td class=\"num\">{}</td><td "
@@ -89,7 +89,7 @@ std::string accuracy_table(const std::map<std::string, std::vector<Measured>>& g
                 fmt::format("{} under {}: the mobile default's mean FLIP against the truth is {}; the best variant {} ({}, {}), "
                             "the worst {} ({}).",
                             e(str(*ms[0].t, "scene")), e(str(*ms[0].t, "env")), fmt_num(base), e(variant_name(*lo->t)),
-                            fmt_num(lo->flip), pct(lo->flip, base), e(variant_name(*hi->t)), pct(hi->flip, base)));
+                            fmt_num(lo->flip), pct_of(lo->flip, base), e(variant_name(*hi->t)), pct_of(hi->flip, base)));
     }
     return o + "</table>\n";
 }
@@ -112,13 +112,13 @@ std::string cost_bands(const std::map<std::string, std::vector<Measured>>& group
             for (const Measured& m : ms)
                 if (m.ipp > 0 && m.ipp <= d->ipp * bands[k].first && (!best || m.flip < best->flip)) best = &m;
             o += best ? fmt::format("<td>{} <b>{}</b> <span class=\"meta\">{} FLIP, {} instr/px</span></td>",
-                                    e(variant_name(*best->t)), fmt_num(best->flip), pct(best->flip, d->flip),
-                                    pct(best->ipp, d->ipp))
+                                    e(variant_name(*best->t)), fmt_num(best->flip), pct_of(best->flip, d->flip),
+                                    pct_of(best->ipp, d->ipp))
                       : std::string("<td>&ndash;</td>");
             if (best && k == 1 && best != d)
                 words.push_back(fmt::format(
                     "{} under {}: within +10 % of the default's instructions, {} is the most accurate ({} FLIP).",
-                    e(str(*ms[0].t, "scene")), e(str(*ms[0].t, "env")), e(variant_name(*best->t)), pct(best->flip, d->flip)));
+                    e(str(*ms[0].t, "scene")), e(str(*ms[0].t, "env")), e(variant_name(*best->t)), pct_of(best->flip, d->flip)));
         }
         o += "</tr>\n";
     }
@@ -161,7 +161,7 @@ std::string since_last_run(const json& results, const std::vector<json>& history
         if (acc || ipp)
             rows.push_back(
                 fmt::format("<tr><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td></tr>\n",
-                            e(name), acc ? fmt::format("{} &rarr; {} ({})", fmt_num(*a), fmt_num(*b), pct(*b, *a)) : "",
+                            e(name), acc ? fmt::format("{} &rarr; {} ({})", fmt_num(*a), fmt_num(*b), pct_of(*b, *a)) : "",
                             ipp ? fmt::format("{} &rarr; {}", fmt_num(*ia), fmt_num(*ib)) : "", acc ? fmt_num(floor) : ""));
     }
     for (const auto& [name, t] : then.items()) gone += !now.contains(name);

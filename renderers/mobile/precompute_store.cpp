@@ -14,7 +14,7 @@ namespace iblcheck {
 
 namespace {
 
-constexpr uint32_t kMagic = 0x31434249; // "IBC1": this layout; another is a miss
+constexpr uint32_t kPrecomputeMagic = 0x31434249; // "IBC1": this layout; another is a miss
 constexpr uint32_t kEndMark = 0x444e4549;
 
 // The shaders the passes compile (ibl_precompute.cpp); their includes are hashed with them.
@@ -109,7 +109,7 @@ bool get_image(vk::Context& ctx, Reader& rd, vk::Image& out) {
     return true;
 }
 
-fs::path entry_path(const std::string& key) { return precompute_store_dir() / (key + ".ibl"); }
+fs::path precompute_entry_path(const std::string& key) { return precompute_store_dir() / (key + ".ibl"); }
 
 } // namespace
 
@@ -120,7 +120,7 @@ fs::path precompute_store_dir() {
 std::string precompute_store_key(GpuSession& gpu, const Environment& env, const PrecomputeSettings& s, const std::string& tool) {
     Fnv1a64 h;
     h.update("tool=" + tool + ";");
-    h.update(std::to_string(kMagic) + ";" + precompute_key(env.content_hash, s) + ";");
+    h.update(std::to_string(kPrecomputeMagic) + ";" + precompute_key(env.content_hash, s) + ";");
     for (const char* shader : kPassShaders)
         h.update(std::string(shader) + "=" + vk::file_tree_hash(vk::shader_dir() / shader) + ";");
     const vk::DeviceInfo& i = gpu.ctx().info();
@@ -132,14 +132,14 @@ std::string precompute_store_key(GpuSession& gpu, const Environment& env, const 
 std::optional<IblResources> load_precompute(vk::Context& ctx, const std::string& key, std::vector<PassTiming>& timings) {
     if (precompute_store_dir().empty()) return std::nullopt;
     ProfileStage stage("precompute_store");
-    const std::optional<std::string> entry = read_store_entry(entry_path(key), {}); // the magic is read below
+    const std::optional<std::string> entry = read_store_entry(precompute_entry_path(key), {}); // the magic is read below
     if (!entry) return std::nullopt;
     const std::string& bytes = *entry;
     Reader rd{bytes};
     uint32_t magic = 0, end = 0, n_timings = 0;
     uint8_t native = 0;
     IblResources r;
-    if (!rd.get(magic) || magic != kMagic || !rd.get(r.full_mips) || !rd.get(r.levels) || !rd.get(native) ||
+    if (!rd.get(magic) || magic != kPrecomputeMagic || !rd.get(r.full_mips) || !rd.get(r.levels) || !rd.get(native) ||
         !rd.get(r.texel_count) || !rd.get(r.texture_bytes) || !rd.get(r.rgbm_range) || !rd.get(r.rgbm_clipped_energy) ||
         !rd.get(n_timings) || n_timings > 64)
         return std::nullopt;
@@ -166,7 +166,7 @@ void save_precompute(vk::Context& ctx, const std::string& key, const IblResource
     if (precompute_store_dir().empty()) return;
     ProfileStage stage("precompute_store");
     Writer w;
-    w.put(kMagic);
+    w.put(kPrecomputeMagic);
     w.put(r.full_mips);
     w.put(r.levels);
     w.put(uint8_t(r.native_r11g11b10));
@@ -187,7 +187,7 @@ void save_precompute(vk::Context& ctx, const std::string& key, const IblResource
     put_image(ctx, w, r.lut);
     put_image(ctx, w, r.irradiance);
     w.put(kEndMark);
-    write_store_entry(entry_path(key), w.bytes);
+    write_store_entry(precompute_entry_path(key), w.bytes);
 }
 
 } // namespace iblcheck
