@@ -12,7 +12,7 @@ root="$(cd "$(dirname "$0")/.." && pwd)"
 if [[ "${IBLCHECK_NO_SANITIZERS:-0}" == 1 ]]; then echo "[sanitize] skipped (IBLCHECK_NO_SANITIZERS=1)"; exit 0; fi
 jobs="$(nproc)"
 source "$root/scripts/cmake_env.sh"
-asan_tests=(test_verdict test_metrics_flip test_metrics_ssim_psnr test_scenes_environments)
+asan_tests=(test_units)
 
 echo "[sanitize] ASan+UBSan build of ${asan_tests[*]}"
 cmake -S "$root" -B "$root/build-asan" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DIBLCHECK_SANITIZE=address >/dev/null

@@ -25,6 +25,9 @@ namespace fs = std::filesystem;
 using namespace iblcheck;
 using iblcheck::testing_support::synthetic;
 
+// Its own namespace: the test programs of one group compile as one unity unit (tests/CMakeLists.txt).
+namespace test_metrics_flip {
+
 namespace {
 
 const fs::path kVectors = fs::path(IBLCHECK_SHARED_DIR) / "flip-vectors";
@@ -313,3 +316,5 @@ TEST(DisplayTransform, AcesThenSrgb) {
 }
 
 } // namespace
+
+} // namespace test_metrics_flip

@@ -23,6 +23,9 @@
 namespace fs = std::filesystem;
 using namespace iblcheck;
 
+// Its own namespace: the test programs of one group compile as one unity unit (tests/CMakeLists.txt).
+namespace test_metrics_ssim_psnr {
+
 namespace {
 
 const fs::path kVectors = fs::path(IBLCHECK_SHARED_DIR) / "flip-vectors";
@@ -317,3 +320,5 @@ TEST(SsimPsnr, IdenticalInputsSkipWithTheSameResult) {
     EXPECT_TRUE(std::isnan(compute_ssim(nan, nan.clone()).mean));
     EXPECT_TRUE(std::isnan(compute_psnr(nan, nan.clone()).rmse));
 }
+
+} // namespace test_metrics_ssim_psnr

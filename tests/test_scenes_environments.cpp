@@ -17,6 +17,9 @@
 using namespace iblcheck;
 namespace fs = std::filesystem;
 
+// Its own namespace: the test programs of one group compile as one unity unit (tests/CMakeLists.txt).
+namespace test_scenes_environments {
+
 namespace {
 constexpr double kPi = 3.14159265358979323846;
 
@@ -451,3 +454,5 @@ TEST(Environment, ContentHashIsFnv1a64) {
     const cv::Mat two = bytes("foobar").reshape(1, 2);
     EXPECT_EQ(fnv1a64_hex(two), "85944171f73967e8");
 }
+
+} // namespace test_scenes_environments

@@ -12,6 +12,9 @@
 using namespace iblcheck;
 using nlohmann::json;
 
+// Its own namespace: the test programs of one group compile as one unity unit (tests/CMakeLists.txt).
+namespace test_verdict {
+
 namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
@@ -205,3 +208,5 @@ TEST(Verdict, ExitCodesOfRunRepeatAndBisect) {
     EXPECT_EQ(bisect_verdict_name(kExitRegression), "bad");
     EXPECT_EQ(bisect_verdict_name(kExitCannotTest), "skip (125)");
 }
+
+} // namespace test_verdict
