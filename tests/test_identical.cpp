@@ -46,7 +46,7 @@ TEST(BitIdentical, NanBytesAreIdenticalButNotFinite) {
 
 TEST(BitIdentical, SizeAndTypeMustMatch) {
     const cv::Mat a = ramp(8, 8);
-    EXPECT_FALSE(bit_identical(a, ramp(8, 4)));  // a shorter image whose bytes start the same
+    EXPECT_FALSE(bit_identical(a, ramp(8, 4))); // a shorter image whose bytes start the same
     EXPECT_FALSE(bit_identical(ramp(8, 4), a));
     EXPECT_FALSE(bit_identical(a, a.reshape(1))); // the same bytes as one channel
     cv::Mat u8(8, 8, CV_8UC3, cv::Scalar::all(0)), u8b = u8.clone();
