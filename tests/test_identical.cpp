@@ -42,6 +42,8 @@ TEST(BitIdentical, NanBytesAreIdenticalButNotFinite) {
     const cv::Mat b = a.clone();
     EXPECT_TRUE(bit_identical(a, b));     // a golden with the same NaN is not rewritten
     EXPECT_FALSE(identical_finite(a, b)); // but its metrics are not known without computing them
+    EXPECT_TRUE(bit_identical(a, a));
+    EXPECT_FALSE(identical_finite(a, a)); // the same pixels still hold a NaN
 }
 
 TEST(BitIdentical, SizeAndTypeMustMatch) {
