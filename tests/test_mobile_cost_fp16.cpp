@@ -7,12 +7,12 @@
 
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <filesystem>
 #include <fstream>
 
 #include "image_io/image_io.h"
 #include "metrics/flip.h"
+#include "metrics/identical.h"
 #include "renderers/environments/environment.h"
 #include "renderers/mobile/gpu_session.h"
 #include "renderers/mobile/mobile_renderer.h"
@@ -90,10 +90,6 @@ RenderResult render_in(GpuSession& gpu, const TestSpec& s) {
     validate_spec(s);
     Environment env = load_environment(s.env);
     return s.method == "sampled" ? render_sampled(gpu, env, s) : render_mobile(gpu, env, s);
-}
-
-bool identical(const cv::Mat& a, const cv::Mat& b) {
-    return a.size() == b.size() && std::memcmp(a.data, b.data, a.total() * a.elemSize()) == 0;
 }
 
 } // namespace
@@ -210,7 +206,7 @@ TEST(MobileCost, ShadingTwiceDoublesTheCountAndARunawayLoopMultipliesIt) {
            "            sum += 0.5 * (shade_ray(p) + shade_ray(p));\n"
            "        }");
     RenderResult twice = render_modified(s);
-    EXPECT_TRUE(identical(twice.image, base.image));
+    EXPECT_TRUE(bit_identical(twice.image, base.image));
     double factor = twice.shader_instructions_per_pixel / base.shader_instructions_per_pixel;
     RecordProperty("twice_factor", std::to_string(factor));
     EXPECT_GE(factor, 1.9) << twice.shader_instructions_per_pixel << " vs " << base.shader_instructions_per_pixel;
@@ -223,7 +219,7 @@ TEST(MobileCost, ShadingTwiceDoublesTheCountAndARunawayLoopMultipliesIt) {
            "    for (uint k = 0u; k < 2500u; ++k) waste += sin(float(k) * roughness);\n"
            "    return vec3(diffuse + specular) + vec3(0.0) * waste;\n}");
     RenderResult runaway = render_modified(small);
-    EXPECT_TRUE(identical(runaway.image, base_small.image));
+    EXPECT_TRUE(bit_identical(runaway.image, base_small.image));
     double runaway_factor = runaway.shader_instructions_per_pixel / base_small.shader_instructions_per_pixel;
     RecordProperty("runaway_factor", std::to_string(runaway_factor));
     EXPECT_GT(runaway_factor, 10.0) << runaway.shader_instructions_per_pixel << " vs "

@@ -7,7 +7,6 @@
 #include <nlohmann/json.hpp>
 
 #include <chrono>
-#include <cstring>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
@@ -31,6 +30,7 @@
 #include "kernel/profile.h"
 #include "kernel/program.h"
 #include "metrics/display_transform.h"
+#include "metrics/identical.h"
 #include "renderers/environments/environment.h"
 #include "renderers/mobile/cost_store.h"
 #include "renderers/mobile/precompute_store.h"
@@ -285,10 +285,6 @@ RenderResult fresh_render(const TestSpec& spec, const std::string& store) {
     return out;
 }
 
-bool same_pixels(const cv::Mat& a, const cv::Mat& b) {
-    return a.size() == b.size() && a.type() == b.type() && std::memcmp(a.data, b.data, a.total() * a.elemSize()) == 0;
-}
-
 TestSpec furnace_spec(const std::map<std::string, std::string>& options) {
     TestSpec s;
     s.scene = "furnace";
@@ -328,7 +324,7 @@ TEST(SharedPrecompute, VariantsOfOneChainShareItAndRenderAsIfAlone) {
         const RenderResult r = shared.render(spec);
         EXPECT_FALSE(r.provenance["precompute_cached"].get<bool>()) << what; // its own precompute...
         EXPECT_EQ(prefilter_ms(r), prefilter_ms(first)) << what;             // ...from the shared chain
-        EXPECT_TRUE(same_pixels(r.image, fresh_render(spec, "0").image)) << what;
+        EXPECT_TRUE(bit_identical(r.image, fresh_render(spec, "0").image)) << what;
     }
     unsetenv("IBLCHECK_PRECOMPUTE_CACHE");
 }
@@ -352,8 +348,8 @@ TEST(PrecomputeStore, StoredPrecomputeRendersBitIdenticallyAndADamagedEntryIsRec
         const RenderResult loaded = fresh_render(spec, dir.string()); // reads it
         EXPECT_FALSE(stored.provenance["precompute_cached"].get<bool>()) << what;
         EXPECT_TRUE(loaded.provenance["precompute_cached"].get<bool>()) << what;
-        EXPECT_TRUE(same_pixels(computed.image, stored.image)) << what;
-        EXPECT_TRUE(same_pixels(computed.image, loaded.image)) << what;
+        EXPECT_TRUE(bit_identical(computed.image, stored.image)) << what;
+        EXPECT_TRUE(bit_identical(computed.image, loaded.image)) << what;
         EXPECT_EQ(computed.provenance["rgbm"], loaded.provenance["rgbm"]) << what;
         EXPECT_EQ(computed.provenance["texture"], loaded.provenance["texture"]) << what;
     }
@@ -362,7 +358,7 @@ TEST(PrecomputeStore, StoredPrecomputeRendersBitIdenticallyAndADamagedEntryIsRec
     const TestSpec spec = furnace_spec({{"storage", "rgbm8"}});
     const RenderResult again = fresh_render(spec, dir.string());
     EXPECT_FALSE(again.provenance["precompute_cached"].get<bool>());
-    EXPECT_TRUE(same_pixels(again.image, fresh_render(spec, "0").image));
+    EXPECT_TRUE(bit_identical(again.image, fresh_render(spec, "0").image));
     fs::remove_all(dir);
 }
 
@@ -855,9 +851,6 @@ TEST(TimingGroups, ARunPoolsTheRendersOfAGroup) {
 namespace {
 // A frame of `rows` x 4 pixels whose every value is `v`.
 cv::Mat frame_of(float v, int rows = 3) { return cv::Mat(rows, 4, CV_32FC3, cv::Scalar::all(v)); }
-bool same_bytes(const cv::Mat& a, const cv::Mat& b) {
-    return a.size() == b.size() && a.type() == b.type() && std::memcmp(a.data, b.data, a.total() * a.elemSize()) == 0;
-}
 } // namespace
 
 // A sequence's entry is named by every input its frames depend on: any spec field but the frame
@@ -909,7 +902,7 @@ TEST(SequenceStore, ReadsBackOnlyTheWholeEntryOfTheSameFirstFrame) {
     const std::optional<std::vector<cv::Mat>> back = load_sequence("k", frame_of(0.25f), 3);
     ASSERT_TRUE(back);
     ASSERT_EQ(back->size(), 3u);
-    for (size_t i = 0; i < 3; ++i) EXPECT_TRUE(same_bytes((*back)[i], frames[i])) << i;
+    for (size_t i = 0; i < 3; ++i) EXPECT_TRUE(bit_identical((*back)[i], frames[i])) << i;
     EXPECT_FALSE(load_sequence("k", frame_of(0.2500001f), 3)) << "frame 0 renders differently now";
     EXPECT_FALSE(load_sequence("k", frame_of(0.25f, 2), 3)) << "another size";
     EXPECT_FALSE(load_sequence("k", frame_of(0.25f), 2)) << "another frame count";
